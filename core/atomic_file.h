@@ -1,0 +1,26 @@
+#pragma once
+// Atomic file writing: readers see either the old file or the complete new one, never a part.
+
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <string>
+
+namespace ihs {
+
+/// Writes `path` atomically: `write` fills a binary stream for a temporary file in the same folder,
+/// which then replaces `path` by rename. Throws ihs::OutputError (naming the path) when the folder
+/// is missing or unwritable or the data cannot be written completely (e.g. a full disk); the
+/// temporary file is removed and an existing `path` is left untouched. Exceptions thrown by
+/// `write` propagate after the same clean-up.
+void WriteFileAtomically(const std::filesystem::path& path,
+                         const std::function<void(std::ostream&)>& write);
+
+/// Convenience: writes `contents` to `path` atomically.
+void WriteFileAtomically(const std::filesystem::path& path, const std::string& contents);
+
+/// Reads a whole file into a string. Throws ihs::InputError naming the path when it is missing,
+/// not a regular file, or unreadable.
+std::string ReadFileToString(const std::filesystem::path& path);
+
+}  // namespace ihs

@@ -1,0 +1,46 @@
+#include "tests/mesh_fixtures.h"
+
+#include <cmath>
+
+namespace ihs::test {
+
+TriangleMesh MakeCube(float edge_mm) {
+  const float h = edge_mm / 2;
+  TriangleMesh mesh;
+  for (int i = 0; i < 8; ++i) {
+    mesh.vertices.emplace_back(i & 1 ? h : -h, i & 2 ? h : -h, i & 4 ? h : -h);
+  }
+  // Two triangles per side, counter-clockwise seen from outside.
+  mesh.faces = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  return mesh;
+}
+
+TriangleMesh MakeUvSphere(float radius_mm, int rings, int segments, const Eigen::Vector3f& center) {
+  TriangleMesh mesh;
+  mesh.vertices.push_back(center + Eigen::Vector3f(0, 0, radius_mm));  // North pole.
+  for (int r = 1; r < rings; ++r) {
+    const double theta = M_PI * r / rings;
+    for (int s = 0; s < segments; ++s) {
+      const double phi = 2 * M_PI * s / segments;
+      mesh.vertices.push_back(center + radius_mm * Eigen::Vector3f(std::sin(theta) * std::cos(phi),
+                                                                   std::sin(theta) * std::sin(phi),
+                                                                   std::cos(theta)));
+    }
+  }
+  mesh.vertices.push_back(center - Eigen::Vector3f(0, 0, radius_mm));  // South pole.
+  const int south = static_cast<int>(mesh.vertices.size()) - 1;
+  auto ring_vertex = [&](int r, int s) { return 1 + (r - 1) * segments + (s % segments); };
+  for (int s = 0; s < segments; ++s) {
+    mesh.faces.push_back({0, ring_vertex(1, s), ring_vertex(1, s + 1)});
+    mesh.faces.push_back({south, ring_vertex(rings - 1, s + 1), ring_vertex(rings - 1, s)});
+    for (int r = 1; r + 1 < rings; ++r) {
+      mesh.faces.push_back({ring_vertex(r, s), ring_vertex(r + 1, s), ring_vertex(r + 1, s + 1)});
+      mesh.faces.push_back({ring_vertex(r, s), ring_vertex(r + 1, s + 1), ring_vertex(r, s + 1)});
+    }
+  }
+  for (const Eigen::Vector3f& v : mesh.vertices) mesh.normals.push_back((v - center).normalized());
+  return mesh;
+}
+
+}  // namespace ihs::test

@@ -1,0 +1,39 @@
+#pragma once
+// Helpers shared by the test binaries.
+
+#include <cstdint>
+#include <filesystem>
+#include <random>
+#include <string>
+
+namespace ihs::test {
+
+/// The seed of this test run: IHS_TEST_SEED if set, else a fixed value. The shared main seeds
+/// std::srand with it and prints it, so a failure can be reproduced.
+std::uint32_t Seed();
+
+/// A random generator seeded from Seed() and `stream`, so that tests draw independent sequences.
+std::mt19937 Rng(std::uint32_t stream = 0);
+
+/// A fresh empty folder under the system temp folder, removed with its contents on destruction.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  /// `path() / name`.
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Reads a whole file; empty if it cannot be read.
+std::string ReadFileString(const std::filesystem::path& path);
+
+/// Writes `bytes` to `path` (plain, non-atomic), for preparing test inputs.
+void WriteBytes(const std::filesystem::path& path, const std::string& bytes);
+
+}  // namespace ihs::test

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs missing dependencies, configures and builds the project.
+#   IHS_BUILD_DIR   build folder (default: build)
+#   IHS_BUILD_TYPE  CMake build type (default: Release)
+#   IHS_SANITIZE    "", "address,undefined" or "thread": a sanitizer build
+#   IHS_JOBS        parallel jobs (default: number of cores)
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/tools/install-deps.sh"
+
+build_dir="${IHS_BUILD_DIR:-build}"
+[[ "$build_dir" = /* ]] || build_dir="$root/$build_dir"
+build_type="${IHS_BUILD_TYPE:-Release}"
+sanitize="${IHS_SANITIZE:-}"
+jobs="${IHS_JOBS:-$(nproc)}"
+
+generator=()
+if [[ ! -f "$build_dir/CMakeCache.txt" ]] && command -v ninja >/dev/null 2>&1; then
+  generator=(-G Ninja)
+fi
+cmake -S "$root" -B "$build_dir" "${generator[@]}" \
+  -DCMAKE_BUILD_TYPE="$build_type" -DIHS_SANITIZE="$sanitize" >/dev/null
+cmake --build "$build_dir" --parallel "$jobs"
