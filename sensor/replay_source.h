@@ -1,0 +1,71 @@
+#pragma once
+// The replay-device shim: a FrameSource that serves frames from memory or from another source,
+// with faults injected on purpose, so that pipeline tests can exercise every way a real sensor
+// or recording misbehaves.
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "sensor/frame_source.h"
+
+namespace ihs::sensor {
+
+/// Faults to inject, keyed by the 0-based index of the frame in the underlying stream.
+struct FaultPlan {
+  /// Frames never delivered (as a sensor that drops frames).
+  std::set<std::int64_t> drop;
+  /// Frames delivered with the timestamps of the frame before them.
+  std::set<std::int64_t> duplicate_timestamp;
+  /// Frames delivered only after a stall of this many milliseconds.
+  std::map<std::int64_t, int> stall_ms;
+  /// After this many frames have been read from the underlying stream, report kDisconnected.
+  std::optional<std::int64_t> disconnect_after;
+  /// Frames delivered with a depth image of the wrong size (fails Frame::Check).
+  std::set<std::int64_t> wrong_size;
+  /// Frames delivered with no valid depth at all.
+  std::set<std::int64_t> all_zero;
+};
+
+/// Serves frames from a list or another source, applying a FaultPlan.
+class ReplaySource : public FrameSource {
+ public:
+  /// Serves `frames` (indices and timestamps as given) with `intrinsics`. `live` makes it
+  /// report IsLive(), for tests of the live code path.
+  ReplaySource(std::vector<Frame> frames, const CameraIntrinsics& intrinsics, FaultPlan faults = {},
+               bool live = false);
+  /// Serves the frames of `inner` (started and stopped with this source).
+  ReplaySource(std::unique_ptr<FrameSource> inner, FaultPlan faults);
+  ~ReplaySource() override;
+
+  void Start() override;
+  void Stop() override;
+  SourceRead Next(std::chrono::milliseconds timeout) override;
+  CameraIntrinsics Intrinsics() const override;
+  std::string Description() const override;
+  std::optional<std::int64_t> FrameCount() const override;
+  bool IsLive() const override { return live_; }
+
+ private:
+  // The next frame of the underlying stream, before faults.
+  SourceRead ReadUnderlying(std::chrono::milliseconds timeout);
+
+  std::vector<Frame> frames_;
+  CameraIntrinsics intrinsics_;
+  std::unique_ptr<FrameSource> inner_;
+  const FaultPlan faults_;
+  const bool live_;
+  bool started_ = false;
+  std::int64_t next_index_ = 0;  // Index of the next underlying frame.
+  std::optional<Frame> previous_;
+  // A frame held back by a stall, and when it may be delivered.
+  std::shared_ptr<const Frame> stalled_;
+  std::chrono::steady_clock::time_point stalled_until_;
+};
+
+}  // namespace ihs::sensor

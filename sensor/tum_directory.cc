@@ -1,0 +1,346 @@
+#include "sensor/tum_directory.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <tuple>
+#include <utility>
+
+#include "core/atomic_file.h"
+#include "core/check.h"
+#include "core/errors.h"
+
+namespace ihs::sensor {
+namespace fs = std::filesystem;
+namespace {
+
+struct Stamped {
+  double time_s;
+  std::string path;
+};
+
+// Parses a TUM list: lines "timestamp path [...]", '#' comments, blank lines ignored.
+std::vector<Stamped> ReadList(const fs::path& file) {
+  std::istringstream lines(ReadFileToString(file));
+  std::vector<Stamped> list;
+  std::string line;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    Stamped entry;
+    if (!(fields >> entry.time_s >> entry.path) || !std::isfinite(entry.time_s)) {
+      throw InputError(file.string() + ": line " + std::to_string(number) +
+                       " is not 'timestamp path'");
+    }
+    list.push_back(entry);
+  }
+  return list;
+}
+
+bool LooksLikeDepth(const std::string& path) { return path.rfind("depth", 0) == 0; }
+
+std::vector<TumEntry> ReadAssociations(const fs::path& file) {
+  std::istringstream lines(ReadFileToString(file));
+  std::vector<TumEntry> entries;
+  std::string line;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    double t1, t2;
+    std::string p1, p2;
+    if (!(fields >> t1 >> p1 >> t2 >> p2)) {
+      throw InputError(file.string() + ": line " + std::to_string(number) +
+                       " is not 'time path time path'");
+    }
+    // associate.py writes the pair in the order of its arguments: usually rgb, then depth.
+    if (LooksLikeDepth(p1) && !LooksLikeDepth(p2)) {
+      entries.push_back({t1, p1, t2, p2});
+    } else {
+      entries.push_back({t2, p2, t1, p1});
+    }
+  }
+  return entries;
+}
+
+std::string FormatTime(std::int64_t timestamp_us) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6f", timestamp_us / 1e6);
+  return text;
+}
+
+}  // namespace
+
+void TumOptions::Check() const {
+  IHS_CHECK_ARG(depth_scale_per_m > 0 && std::isfinite(depth_scale_per_m),
+                "depth_scale_per_m must be positive, got " << depth_scale_per_m);
+  IHS_CHECK_ARG(max_time_difference_s >= 0,
+                "max_time_difference_s must not be negative, got " << max_time_difference_s);
+  if (intrinsics) intrinsics->Check();
+}
+
+std::vector<TumEntry> ListTumDirectory(const fs::path& folder, const TumOptions& options,
+                                       int* unmatched) {
+  if (unmatched) *unmatched = 0;
+  if (!fs::is_directory(folder)) throw InputError(folder.string() + ": not a folder");
+  if (fs::exists(folder / "associations.txt")) {
+    return ReadAssociations(folder / "associations.txt");
+  }
+  if (!fs::exists(folder / "depth.txt") || !fs::exists(folder / "rgb.txt")) {
+    throw InputError(folder.string() +
+                     ": not a TUM RGB-D folder (needs depth.txt and rgb.txt, or associations.txt)");
+  }
+  std::vector<Stamped> depth = ReadList(folder / "depth.txt");
+  std::vector<Stamped> color = ReadList(folder / "rgb.txt");
+  auto by_time = [](const Stamped& a, const Stamped& b) { return a.time_s < b.time_s; };
+  std::sort(depth.begin(), depth.end(), by_time);
+  std::sort(color.begin(), color.end(), by_time);
+
+  // As associate.py: every pair within the tolerance, closest first, each image used once.
+  std::vector<std::tuple<double, size_t, size_t>> candidates;
+  for (size_t d = 0; d < depth.size(); ++d) {
+    auto it =
+        std::lower_bound(color.begin(), color.end(),
+                         Stamped{depth[d].time_s - options.max_time_difference_s, ""}, by_time);
+    for (; it != color.end() && it->time_s <= depth[d].time_s + options.max_time_difference_s;
+         ++it) {
+      candidates.emplace_back(std::abs(it->time_s - depth[d].time_s), d,
+                              static_cast<size_t>(it - color.begin()));
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  std::vector<int> partner(depth.size(), -1);
+  std::vector<bool> color_used(color.size(), false);
+  for (const auto& [difference, d, c] : candidates) {
+    if (partner[d] >= 0 || color_used[c]) continue;
+    partner[d] = static_cast<int>(c);
+    color_used[c] = true;
+  }
+  std::vector<TumEntry> entries;
+  for (size_t d = 0; d < depth.size(); ++d) {
+    if (partner[d] < 0) {
+      if (unmatched) ++*unmatched;
+      continue;
+    }
+    const Stamped& c = color[partner[d]];
+    entries.push_back({depth[d].time_s, depth[d].path, c.time_s, c.path});
+  }
+  return entries;
+}
+
+CameraIntrinsics ReadIntrinsicsFile(const fs::path& path) {
+  std::istringstream fields(ReadFileToString(path));
+  CameraIntrinsics intrinsics;
+  if (!(fields >> intrinsics.fx >> intrinsics.fy >> intrinsics.cx >> intrinsics.cy >>
+        intrinsics.width >> intrinsics.height)) {
+    throw InputError(path.string() + ": expected 'fx fy cx cy width height'");
+  }
+  try {
+    intrinsics.Check();
+  } catch (const std::invalid_argument& error) {
+    throw InputError(path.string() + ": " + error.what());
+  }
+  return intrinsics;
+}
+
+CameraIntrinsics ParseIntrinsics(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream fields(text);
+  std::string field;
+  while (std::getline(fields, field, ',')) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(field, &used));
+      IHS_CHECK_ARG(used == field.size(), "");
+    } catch (const std::exception&) {
+      throw std::invalid_argument("intrinsics '" + text + "': '" + field + "' is not a number");
+    }
+  }
+  IHS_CHECK_ARG(values.size() == 4 || values.size() == 6,
+                "intrinsics '" << text << "' must be fx,fy,cx,cy or fx,fy,cx,cy,width,height");
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = values[0];
+  intrinsics.fy = values[1];
+  intrinsics.cx = values[2];
+  intrinsics.cy = values[3];
+  if (values.size() == 6) {
+    intrinsics.width = static_cast<int>(values[4]);
+    intrinsics.height = static_cast<int>(values[5]);
+  }
+  intrinsics.Check();
+  return intrinsics;
+}
+
+TumDirectorySource::TumDirectorySource(fs::path folder, TumOptions options)
+    : folder_(std::move(folder)), options_(std::move(options)) {
+  options_.Check();
+}
+
+void TumDirectorySource::Start() {
+  entries_ = ListTumDirectory(folder_, options_, &unmatched_);
+  if (entries_.empty()) {
+    throw InputError(folder_.string() + ": no depth image has a colour image within " +
+                     std::to_string(options_.max_time_difference_s) + " s");
+  }
+  if (unmatched_ > 0) {
+    spdlog::warn("{}: {} depth images have no colour image within {} s and are left out",
+                 folder_.string(), unmatched_, options_.max_time_difference_s);
+  }
+  if (options_.intrinsics) {
+    intrinsics_ = *options_.intrinsics;
+  } else if (fs::exists(folder_ / "intrinsics.txt")) {
+    intrinsics_ = ReadIntrinsicsFile(folder_ / "intrinsics.txt");
+  } else {
+    intrinsics_ = CameraIntrinsics::Carmine109();
+    const cv::Mat first =
+        cv::imread((folder_ / entries_.front().depth_path).string(), cv::IMREAD_ANYDEPTH);
+    if (!first.empty() && (first.cols != intrinsics_.width || first.rows != intrinsics_.height)) {
+      intrinsics_ = intrinsics_.Scaled(first.cols, first.rows);
+    }
+  }
+  next_ = 0;
+  delivered_ = 0;
+  skipped_ = 0;
+}
+
+SourceRead TumDirectorySource::Next(std::chrono::milliseconds) {
+  while (next_ < entries_.size()) {
+    const TumEntry& entry = entries_[next_++];
+    const cv::Mat depth = cv::imread((folder_ / entry.depth_path).string(), cv::IMREAD_ANYDEPTH);
+    const cv::Mat bgr = cv::imread((folder_ / entry.color_path).string(), cv::IMREAD_COLOR);
+    std::string problem;
+    if (depth.empty()) {
+      problem = "cannot read depth image " + entry.depth_path;
+    } else if (depth.type() != CV_16UC1) {
+      problem = "depth image " + entry.depth_path + " is not a 16-bit single-channel image";
+    } else if (bgr.empty()) {
+      problem = "cannot read colour image " + entry.color_path;
+    } else if (bgr.size() != depth.size()) {
+      problem = "colour image " + entry.color_path + " differs in size from its depth image";
+    } else if (depth.cols != intrinsics_.width || depth.rows != intrinsics_.height) {
+      problem = "depth image " + entry.depth_path + " is " + std::to_string(depth.cols) + "x" +
+                std::to_string(depth.rows) + ", the intrinsics say " +
+                std::to_string(intrinsics_.width) + "x" + std::to_string(intrinsics_.height);
+    }
+    if (!problem.empty()) {
+      ++skipped_;
+      spdlog::warn("{}: skipping a frame: {}", folder_.string(), problem);
+      continue;
+    }
+    auto frame = std::make_shared<Frame>(Frame::Blank(depth.cols, depth.rows));
+    const double mm_per_unit = 1000.0 / options_.depth_scale_per_m;
+    for (int v = 0; v < depth.rows; ++v) {
+      const auto* row = depth.ptr<std::uint16_t>(v);
+      for (int u = 0; u < depth.cols; ++u) {
+        const double mm = std::round(row[u] * mm_per_unit);
+        frame->depth_mm[v * depth.cols + u] = mm > 65535.0 ? 0 : static_cast<std::uint16_t>(mm);
+      }
+    }
+    cv::Mat rgb(depth.rows, depth.cols, CV_8UC3, frame->rgb.data());
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    frame->depth_timestamp_us = std::llround(entry.depth_time_s * 1e6);
+    frame->color_timestamp_us = std::llround(entry.color_time_s * 1e6);
+    frame->index = delivered_++;
+    return {SourceStatus::kFrame, std::move(frame), ""};
+  }
+  return {SourceStatus::kEndOfStream, nullptr, "end of " + folder_.string()};
+}
+
+std::optional<std::int64_t> TumDirectorySource::FrameCount() const {
+  return static_cast<std::int64_t>(entries_.size());
+}
+
+TumWriter::TumWriter(fs::path folder, const CameraIntrinsics& intrinsics, TumOptions options)
+    : folder_(std::move(folder)), intrinsics_(intrinsics), options_(std::move(options)) {
+  options_.Check();
+  intrinsics_.Check();
+  std::error_code ec;
+  fs::create_directories(folder_ / "depth", ec);
+  fs::create_directories(folder_ / "rgb", ec);
+  if (!fs::is_directory(folder_ / "depth") || !fs::is_directory(folder_ / "rgb")) {
+    throw OutputError("cannot create the TUM folder " + folder_.string() +
+                      (ec ? ": " + ec.message() : ""));
+  }
+}
+
+TumWriter::~TumWriter() {
+  if (finished_) return;
+  try {
+    Finish();
+  } catch (const std::exception& error) {
+    spdlog::error("{}", error.what());
+  }
+}
+
+void TumWriter::Write(const Frame& frame) {
+  frame.Check();
+  const double units_per_mm = options_.depth_scale_per_m / 1000.0;
+  cv::Mat depth(frame.height, frame.width, CV_16UC1);
+  for (int v = 0; v < frame.height; ++v) {
+    auto* row = depth.ptr<std::uint16_t>(v);
+    for (int u = 0; u < frame.width; ++u) {
+      const double units = std::round(frame.DepthAt(u, v) * units_per_mm);
+      row[u] = units > 65535.0 ? 0 : static_cast<std::uint16_t>(units);
+    }
+  }
+  TumEntry entry;
+  entry.depth_time_s = frame.depth_timestamp_us / 1e6;
+  entry.depth_path = "depth/" + FormatTime(frame.depth_timestamp_us) + ".png";
+  std::vector<std::uint8_t> bytes;
+  cv::imencode(".png", depth, bytes);
+  WriteFileAtomically(folder_ / entry.depth_path, std::string(bytes.begin(), bytes.end()));
+  if (frame.HasColor()) {
+    const cv::Mat rgb(frame.height, frame.width, CV_8UC3,
+                      const_cast<std::uint8_t*>(frame.rgb.data()));
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    entry.color_time_s = frame.color_timestamp_us / 1e6;
+    entry.color_path = "rgb/" + FormatTime(frame.color_timestamp_us) + ".png";
+    cv::imencode(".png", bgr, bytes);
+    WriteFileAtomically(folder_ / entry.color_path, std::string(bytes.begin(), bytes.end()));
+  }
+  entries_.push_back(entry);
+}
+
+void TumWriter::Finish() {
+  finished_ = true;
+  std::ostringstream depth_list, color_list, associations;
+  const char* header = "# written by inhandscan\n# timestamp filename\n";
+  depth_list << header;
+  color_list << header;
+  associations << "# timestamp rgb timestamp depth\n";
+  char line[256];
+  for (const TumEntry& entry : entries_) {
+    std::snprintf(line, sizeof(line), "%.6f %s\n", entry.depth_time_s, entry.depth_path.c_str());
+    depth_list << line;
+    if (entry.color_path.empty()) continue;
+    std::snprintf(line, sizeof(line), "%.6f %s\n", entry.color_time_s, entry.color_path.c_str());
+    color_list << line;
+    std::snprintf(line, sizeof(line), "%.6f %s %.6f %s\n", entry.color_time_s,
+                  entry.color_path.c_str(), entry.depth_time_s, entry.depth_path.c_str());
+    associations << line;
+  }
+  WriteFileAtomically(folder_ / "depth.txt", depth_list.str());
+  WriteFileAtomically(folder_ / "rgb.txt", color_list.str());
+  WriteFileAtomically(folder_ / "associations.txt", associations.str());
+  std::ostringstream intrinsics;
+  intrinsics.precision(17);
+  intrinsics << intrinsics_.fx << ' ' << intrinsics_.fy << ' ' << intrinsics_.cx << ' '
+             << intrinsics_.cy << ' ' << intrinsics_.width << ' ' << intrinsics_.height << '\n';
+  WriteFileAtomically(folder_ / "intrinsics.txt", intrinsics.str());
+}
+
+}  // namespace ihs::sensor

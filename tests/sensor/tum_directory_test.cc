@@ -1,0 +1,133 @@
+#include "sensor/tum_directory.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+
+#include "core/errors.h"
+#include "tests/frame_fixtures.h"
+#include "tests/test_util.h"
+
+namespace ihs::sensor {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::vector<std::shared_ptr<const Frame>> ReadAll(FrameSource& source) {
+  std::vector<std::shared_ptr<const Frame>> frames;
+  source.Start();
+  while (true) {
+    SourceRead read = source.Next(1s);
+    if (read.status != SourceStatus::kFrame) break;
+    frames.push_back(read.frame);
+  }
+  return frames;
+}
+
+void WriteFrames(const std::filesystem::path& folder, const std::vector<Frame>& frames,
+                 const CameraIntrinsics& intrinsics) {
+  TumWriter writer(folder, intrinsics);
+  for (const Frame& frame : frames) writer.Write(frame);
+  writer.Finish();
+}
+
+TEST(TumDirectoryTest, RoundTripsDepthColourTimestampsAndIntrinsicsExactly) {
+  test::TempDir dir;
+  const auto frames = test::MakePatternFrames(4, 64, 48);
+  CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109().Scaled(64, 48);
+  intrinsics.fx = 52.123456789;
+  WriteFrames(dir.path(), frames, intrinsics);
+
+  TumDirectorySource source(dir.path());
+  const auto read = ReadAll(source);
+  ASSERT_EQ(read.size(), frames.size());
+  EXPECT_EQ(source.FrameCount(), 4);
+  EXPECT_DOUBLE_EQ(source.Intrinsics().fx, 52.123456789);
+  EXPECT_EQ(source.Intrinsics().width, 64);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(read[i]->depth_mm, frames[i].depth_mm) << i;
+    EXPECT_EQ(read[i]->rgb, frames[i].rgb) << i;
+    EXPECT_EQ(read[i]->depth_timestamp_us, frames[i].depth_timestamp_us);
+    EXPECT_EQ(read[i]->color_timestamp_us, frames[i].color_timestamp_us);
+    EXPECT_EQ(read[i]->index, static_cast<std::int64_t>(i));
+  }
+}
+
+TEST(TumDirectoryTest, DepthScaleIsAppliedBothWays) {
+  test::TempDir dir;
+  TumOptions options;
+  options.depth_scale_per_m = 1000;  // 1 unit = 1 mm.
+  Frame frame = test::MakePatternFrame(0, 16, 12);
+  {
+    TumWriter writer(dir.path(), CameraIntrinsics{}.Scaled(16, 12), options);
+    writer.Write(frame);
+  }
+  TumDirectorySource as_millimetres(dir.path(), options);
+  EXPECT_EQ(ReadAll(as_millimetres).at(0)->depth_mm, frame.depth_mm);
+  TumDirectorySource as_tum(dir.path());  // Read as 5000 per metre: 1 unit = 0.2 mm.
+  const auto scaled = ReadAll(as_tum).at(0);
+  EXPECT_EQ(scaled->DepthAt(1, 1),
+            static_cast<std::uint16_t>(std::lround(frame.DepthAt(1, 1) / 5.0)));
+}
+
+TEST(TumDirectoryTest, MatchesByNearestTimestampWithoutAssociations) {
+  test::TempDir dir;
+  auto frames = test::MakePatternFrames(5, 16, 12);
+  frames[2].color_timestamp_us = frames[2].depth_timestamp_us + 40'000;  // Beyond 20 ms.
+  WriteFrames(dir.path(), frames, CameraIntrinsics{}.Scaled(16, 12));
+  std::filesystem::remove(dir / "associations.txt");
+
+  int unmatched = -1;
+  const auto entries = ListTumDirectory(dir.path(), TumOptions{}, &unmatched);
+  // Depth 2's colour (at +40 ms) is 6.7 ms from depth 3, but depth 3's own colour is closer.
+  EXPECT_EQ(unmatched, 1);
+  ASSERT_EQ(entries.size(), 4u);
+  for (const TumEntry& entry : entries) {
+    EXPECT_LT(std::abs(entry.color_time_s - entry.depth_time_s), 0.0015);
+  }
+  TumDirectorySource source(dir.path());
+  EXPECT_EQ(ReadAll(source).size(), 4u);
+  EXPECT_EQ(source.UnmatchedDepth(), 1);
+}
+
+TEST(TumDirectoryTest, UnreadableImagesAreSkippedAndCounted) {
+  test::TempDir dir;
+  WriteFrames(dir.path(), test::MakePatternFrames(3, 16, 12), CameraIntrinsics{}.Scaled(16, 12));
+  const auto entries = ListTumDirectory(dir.path(), TumOptions{});
+  test::WriteBytes(dir / entries[1].depth_path, "not a png");
+  TumDirectorySource source(dir.path());
+  const auto frames = ReadAll(source);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(source.SkippedFrames(), 1);
+  EXPECT_EQ(frames[1]->index, 1);  // Indices count delivered frames.
+}
+
+TEST(TumDirectoryTest, BadFoldersAndListsAreInputErrors) {
+  test::TempDir dir;
+  EXPECT_THROW(TumDirectorySource(dir / "missing").Start(), InputError);
+  EXPECT_THROW(TumDirectorySource(dir.path()).Start(), InputError);  // No lists.
+  test::WriteBytes(dir / "depth.txt", "# header\n1.0 depth/a.png\n");
+  test::WriteBytes(dir / "rgb.txt", "1.0\n");
+  try {
+    TumDirectorySource(dir.path()).Start();
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("rgb.txt: line 1"), std::string::npos) << error.what();
+  }
+  test::WriteBytes(dir / "rgb.txt", "5.0 rgb/a.png\n");  // Nothing within 20 ms.
+  EXPECT_THROW(TumDirectorySource(dir.path()).Start(), InputError);
+}
+
+TEST(TumDirectoryTest, ParsesIntrinsicsFromTheCommandLine) {
+  const CameraIntrinsics k = ParseIntrinsics("570.3,570.3,320,240");
+  EXPECT_DOUBLE_EQ(k.fx, 570.3);
+  EXPECT_EQ(k.width, 640);
+  EXPECT_EQ(ParseIntrinsics("100,101,50,40,100,80").height, 80);
+  EXPECT_THROW(ParseIntrinsics("570,570,320"), std::invalid_argument);
+  EXPECT_THROW(ParseIntrinsics("570,abc,320,240"), std::invalid_argument);
+  EXPECT_THROW(ParseIntrinsics("-570,570,320,240"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ihs::sensor
