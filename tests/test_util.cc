@@ -36,6 +36,14 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+std::filesystem::path SharedDataDir() {
+  const char* shared = std::getenv("IHS_SHARED_DIR");
+  std::filesystem::path data = shared ? std::filesystem::path(shared) / "data" : "";
+  std::error_code ec;
+  if (data.empty() || !std::filesystem::is_directory(data, ec)) return {};
+  return std::filesystem::canonical(data, ec);
+}
+
 std::string ReadFileString(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());

@@ -30,6 +30,10 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+/// The shared data folder (`../shared/data` beside the checkout, or $IHS_SHARED_DIR/data), or
+/// an empty path when it is absent: tests that need it then GTEST_SKIP with that reason.
+std::filesystem::path SharedDataDir();
+
 /// Reads a whole file; empty if it cannot be read.
 std::string ReadFileString(const std::filesystem::path& path);
 
