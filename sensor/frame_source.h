@@ -64,6 +64,10 @@ class FrameSource {
   /// Whether this is a live device (frames must never be waited for by the capture thread's
   /// consumer; dropping is allowed) rather than a recording.
   virtual bool IsLive() const = 0;
+  /// Frames the source could not decode and skipped (each also logged with its reason).
+  virtual std::int64_t SkippedFrames() const { return 0; }
+  /// Whether the frames come from a damaged recording that was only partly recovered.
+  virtual bool Recovered() const { return false; }
 };
 
 }  // namespace ihs::sensor

@@ -57,7 +57,7 @@ class TumDirectorySource : public FrameSource {
   bool IsLive() const override { return false; }
 
   /// Listed frames whose images could not be decoded.
-  std::int64_t SkippedFrames() const { return skipped_; }
+  std::int64_t SkippedFrames() const override { return skipped_; }
   /// Depth images without a colour partner (left out).
   int UnmatchedDepth() const { return unmatched_; }
 

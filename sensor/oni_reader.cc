@@ -1,0 +1,427 @@
+#include "sensor/oni_reader.h"
+
+#include <fcntl.h>
+#include <spdlog/spdlog.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/check.h"
+#include "core/errors.h"
+#include "sensor/depth_codec.h"
+
+namespace ihs::sensor {
+namespace {
+
+constexpr std::uint32_t kRecordMagic = 0x0052494E;  // "NIR\0"
+constexpr std::size_t kFileHeaderSize = 24;
+// No real frame is larger than this (1600·1200·3 is OpenNI's own limit); it bounds allocations.
+constexpr std::size_t kMaxFrameBytes = 64u << 20;
+constexpr int kMaxImageSide = 8192;
+
+enum RecordType : std::uint32_t {
+  kNodeAdded_1_0_0_4 = 2,
+  kIntProperty = 3,
+  kRealProperty = 4,
+  kStringProperty = 5,
+  kGeneralProperty = 6,
+  kNodeRemoved = 7,
+  kNodeDataBegin = 8,
+  kNodeStateReady = 9,
+  kNewData = 10,
+  kEnd = 11,
+  kNodeAdded_1_0_0_5 = 12,
+  kNodeAdded = 13,
+  kSeekTable = 14,
+};
+
+template <typename T>
+T Load(const char* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return value;
+}
+
+// Reads fields of one record with bounds checks; any overrun sets `ok` to false.
+class FieldReader {
+ public:
+  FieldReader(const char* data, std::size_t size) : data_(data), size_(size) {}
+  template <typename T>
+  T Get() {
+    if (!ok || size_ - position_ < sizeof(T)) {
+      ok = false;
+      return T{};
+    }
+    const T value = Load<T>(data_ + position_);
+    position_ += sizeof(T);
+    return value;
+  }
+  std::string String() {
+    const std::uint32_t length = Get<std::uint32_t>();
+    if (!ok || length == 0 || length > 4096 || size_ - position_ < length) {
+      ok = false;
+      return {};
+    }
+    std::string text(data_ + position_, length);
+    position_ += length;
+    if (!text.empty() && text.back() == '\0') text.pop_back();
+    return text;
+  }
+  std::string_view Bytes(std::size_t count) {
+    if (!ok || size_ - position_ < count) {
+      ok = false;
+      return {};
+    }
+    std::string_view bytes(data_ + position_, count);
+    position_ += count;
+    return bytes;
+  }
+  bool ok = true;
+
+ private:
+  const char* data_;
+  std::size_t size_;
+  std::size_t position_ = 0;
+};
+
+OniNode* FindNode(std::vector<OniNode>& nodes, std::uint32_t id) {
+  for (OniNode& node : nodes) {
+    if (node.id == id) return &node;
+  }
+  return nullptr;
+}
+
+void ApplyProperty(OniNode& node, std::uint32_t type, const std::string& name,
+                   std::string_view value) {
+  if (type == kGeneralProperty && name == "xnMapOutputMode" && value.size() == 12) {
+    node.width = static_cast<int>(Load<std::uint32_t>(value.data()));
+    node.height = static_cast<int>(Load<std::uint32_t>(value.data() + 4));
+    node.fps = static_cast<int>(Load<std::uint32_t>(value.data() + 8));
+  } else if (type == kGeneralProperty && name == "xnFOV" && value.size() >= 16) {
+    node.horizontal_fov_rad = Load<double>(value.data());
+    node.vertical_fov_rad = Load<double>(value.data() + 8);
+  } else if (type == kIntProperty && value.size() >= 8) {
+    const auto number = static_cast<std::int64_t>(Load<std::uint64_t>(value.data()));
+    if (name == "oniPixelFormat") {
+      node.pixel_format = static_cast<int>(number);
+    } else if (name == "xnPixelFormat" && node.type != static_cast<int>(OniNodeType::kDepth)) {
+      static const int kFromOpenNi1[] = {0, 200, 201, 202, 203, 204};
+      if (number >= 1 && number <= 5) node.pixel_format = kFromOpenNi1[number];
+    }
+  }
+}
+
+}  // namespace
+
+const OniNode* OniIndex::FirstOfType(OniNodeType type) const {
+  for (const OniNode& node : nodes) {
+    if (node.type == static_cast<std::int32_t>(type)) return &node;
+  }
+  return nullptr;
+}
+
+OniIndex IndexOni(std::string_view bytes, const std::string& name) {
+  if (bytes.size() < kFileHeaderSize || std::memcmp(bytes.data(), "NI10", 4) != 0) {
+    throw InputError(name + ": not an .oni recording (no NI10 header)");
+  }
+  const auto major = static_cast<std::uint8_t>(bytes[4]);
+  const auto minor = static_cast<std::uint8_t>(bytes[5]);
+  const auto maintenance = Load<std::uint16_t>(bytes.data() + 6);
+  const auto build = Load<std::uint32_t>(bytes.data() + 8);
+  OniIndex index;
+  index.version = std::to_string(major) + "." + std::to_string(minor) + "." +
+                  std::to_string(maintenance) + "." + std::to_string(build);
+  const auto version = std::make_tuple(major, minor, maintenance, build);
+  if (version < std::make_tuple(1, 0, 0, 4) || version > std::make_tuple(1, 0, 1, 0)) {
+    throw InputError(name + ": unsupported .oni version " + index.version);
+  }
+  const bool wide = version >= std::make_tuple(1, 0, 1, 0);
+  const std::size_t header_size = wide ? 28 : 24;
+
+  std::size_t position = kFileHeaderSize;
+  auto stop = [&](const std::string& why) {
+    index.damage = why + " at byte " + std::to_string(position);
+  };
+  while (true) {
+    if (position == bytes.size()) {
+      stop("the file ends without an END record");
+      break;
+    }
+    if (bytes.size() - position < header_size) {
+      stop("the file ends inside a record header");
+      break;
+    }
+    const char* record = bytes.data() + position;
+    const auto magic = Load<std::uint32_t>(record);
+    const auto type = Load<std::uint32_t>(record + 4);
+    const auto node_id = Load<std::uint32_t>(record + 8);
+    const auto fields_size = Load<std::uint32_t>(record + 12);
+    const auto payload_size = Load<std::uint32_t>(record + 16);
+    if (magic != kRecordMagic || fields_size < header_size) {
+      stop("invalid record header");
+      break;
+    }
+    const std::size_t available = bytes.size() - position;
+    if (fields_size > available || payload_size > available - fields_size) {
+      stop("the file ends inside a record");
+      break;
+    }
+    FieldReader fields(record + header_size, fields_size - header_size);
+    bool known = true;
+    switch (type) {
+      case kNodeAdded:
+      case kNodeAdded_1_0_0_5:
+      case kNodeAdded_1_0_0_4: {
+        OniNode node;
+        node.id = node_id;
+        node.name = fields.String();
+        node.type = fields.Get<std::int32_t>();
+        node.codec = fields.Get<std::uint32_t>();
+        if (type != kNodeAdded_1_0_0_4) node.declared_frames = fields.Get<std::uint32_t>();
+        if (node.type == static_cast<std::int32_t>(OniNodeType::kDepth)) node.pixel_format = 100;
+        if (node.type == static_cast<std::int32_t>(OniNodeType::kImage)) node.pixel_format = 200;
+        if (node.type == static_cast<std::int32_t>(OniNodeType::kIr)) node.pixel_format = 203;
+        if (fields.ok) {
+          if (OniNode* existing = FindNode(index.nodes, node_id)) {
+            // OpenNI rewrites NODE_ADDED at close; a repeated one (after looping) keeps the frames.
+            node.frames = std::move(existing->frames);
+            *existing = std::move(node);
+          } else {
+            index.nodes.push_back(std::move(node));
+          }
+        }
+        break;
+      }
+      case kIntProperty:
+      case kRealProperty:
+      case kStringProperty:
+      case kGeneralProperty: {
+        const std::string property = fields.String();
+        const std::uint32_t value_size = fields.Get<std::uint32_t>();
+        const std::string_view value = fields.Bytes(value_size);
+        if (OniNode* node = FindNode(index.nodes, node_id); node && fields.ok) {
+          ApplyProperty(*node, type, property, value);
+        }
+        break;
+      }
+      case kNewData: {
+        OniFrameRecord frame;
+        frame.timestamp_us = fields.Get<std::uint64_t>();
+        frame.frame_number = fields.Get<std::uint32_t>();
+        frame.payload_offset = position + fields_size;
+        frame.payload_size = payload_size;
+        OniNode* node = FindNode(index.nodes, node_id);
+        if (fields.ok && node) node->frames.push_back(frame);
+        break;
+      }
+      case kNodeRemoved:
+      case kNodeDataBegin:
+      case kNodeStateReady:
+      case kSeekTable:
+        break;
+      case kEnd:
+        index.complete = true;
+        break;
+      default:
+        known = false;
+    }
+    if (!known) {
+      stop("unknown record type " + std::to_string(type));
+      break;
+    }
+    if (!fields.ok) {
+      stop("malformed record of type " + std::to_string(type));
+      break;
+    }
+    if (index.complete) break;
+    position += static_cast<std::size_t>(fields_size) + payload_size;
+  }
+  return index;
+}
+
+bool DecodeOniDepth(std::string_view bytes, const OniNode& node, const OniFrameRecord& record,
+                    std::vector<std::uint16_t>& depth_mm) {
+  if (node.width <= 0 || node.height <= 0 || node.width > kMaxImageSide ||
+      node.height > kMaxImageSide || record.payload_size > kMaxFrameBytes ||
+      record.payload_offset > bytes.size() ||
+      record.payload_size > bytes.size() - record.payload_offset) {
+    return false;
+  }
+  const std::size_t pixels = static_cast<std::size_t>(node.width) * node.height;
+  const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data() + record.payload_offset);
+  bool ok = false;
+  switch (node.codec) {
+    case kOniCodecNone:
+      ok = record.payload_size == pixels * 2;
+      if (ok) {
+        depth_mm.resize(pixels);
+        std::memcpy(depth_mm.data(), data, pixels * 2);
+      }
+      break;
+    case kOniCodec16z:
+      ok = Decode16z(data, record.payload_size, pixels, depth_mm);
+      break;
+    case kOniCodec16zT:
+      ok = Decode16zTable(data, record.payload_size, pixels, depth_mm);
+      break;
+    default:
+      return false;
+  }
+  if (!ok || depth_mm.size() != pixels) return false;
+  if (node.pixel_format == 101) {  // DEPTH_100_UM: tenths of a millimetre.
+    for (std::uint16_t& d : depth_mm) d = static_cast<std::uint16_t>((d + 5) / 10);
+  }
+  return true;
+}
+
+bool DecodeOniColor(std::string_view bytes, const OniNode& node, const OniFrameRecord& record,
+                    std::vector<std::uint8_t>& rgb) {
+  if (node.width <= 0 || node.height <= 0 || node.width > kMaxImageSide ||
+      node.height > kMaxImageSide || record.payload_size > kMaxFrameBytes ||
+      record.payload_offset > bytes.size() ||
+      record.payload_size > bytes.size() - record.payload_offset || node.pixel_format != 200) {
+    return false;
+  }
+  const std::size_t size = static_cast<std::size_t>(node.width) * node.height * 3;
+  const char* data = bytes.data() + record.payload_offset;
+  if (node.codec == kOniCodecNone) {
+    if (record.payload_size != size) return false;
+    rgb.assign(data, data + size);
+    return true;
+  }
+  if (node.codec != kOniCodecJpeg) return false;
+  const cv::Mat encoded(1, static_cast<int>(record.payload_size), CV_8UC1, const_cast<char*>(data));
+  cv::Mat bgr;
+  try {
+    bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
+  } catch (const cv::Exception&) {
+    return false;
+  }
+  if (bgr.empty() || bgr.cols != node.width || bgr.rows != node.height) return false;
+  rgb.resize(size);
+  cv::Mat out(node.height, node.width, CV_8UC3, rgb.data());
+  cv::cvtColor(bgr, out, cv::COLOR_BGR2RGB);
+  return true;
+}
+
+// A read-only memory map of the file, so that large recordings are not copied into memory.
+struct OniFileSource::Mapping {
+  int fd = -1;
+  void* address = MAP_FAILED;
+  std::size_t size = 0;
+  std::string_view bytes() const {
+    return size ? std::string_view(static_cast<const char*>(address), size) : std::string_view();
+  }
+  ~Mapping() {
+    if (address != MAP_FAILED) munmap(address, size);
+    if (fd >= 0) close(fd);
+  }
+};
+
+OniFileSource::OniFileSource(std::filesystem::path path, std::int64_t max_color_offset_us)
+    : path_(std::move(path)), max_color_offset_us_(max_color_offset_us) {
+  IHS_CHECK_ARG(max_color_offset_us_ >= 0, "max_color_offset_us must not be negative");
+}
+
+OniFileSource::~OniFileSource() = default;
+
+void OniFileSource::Start() {
+  const std::string name = path_.string();
+  auto mapping = std::make_unique<Mapping>();
+  mapping->fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC);
+  if (mapping->fd < 0) throw InputError(name + ": cannot open: " + std::strerror(errno));
+  struct stat status {};
+  if (fstat(mapping->fd, &status) != 0 || !S_ISREG(status.st_mode)) {
+    throw InputError(name + ": not a regular file");
+  }
+  mapping->size = static_cast<std::size_t>(status.st_size);
+  if (mapping->size == 0) throw InputError(name + ": the file is empty");
+  mapping->address = mmap(nullptr, mapping->size, PROT_READ, MAP_PRIVATE, mapping->fd, 0);
+  if (mapping->address == MAP_FAILED) {
+    throw InputError(name + ": cannot map: " + std::strerror(errno));
+  }
+  index_ = IndexOni(mapping->bytes(), name);
+  depth_ = index_.FirstOfType(OniNodeType::kDepth);
+  color_ = index_.FirstOfType(OniNodeType::kImage);
+  if (!depth_) throw InputError(name + ": the recording has no depth stream");
+  if (depth_->frames.empty()) {
+    throw InputError(name + ": the recording holds no complete depth frame" +
+                     (index_.damage.empty() ? "" : " (" + index_.damage + ")"));
+  }
+  if (depth_->width <= 0 || depth_->height <= 0) {
+    throw InputError(name + ": the depth stream has no image size (xnMapOutputMode)");
+  }
+  if (!index_.complete) {
+    spdlog::warn("{}: damaged recording ({}); recovered {} complete depth frames", name,
+                 index_.damage, depth_->frames.size());
+  }
+  const OniNode& geometry = color_ && color_->horizontal_fov_rad > 0.1 ? *color_ : *depth_;
+  if (geometry.horizontal_fov_rad > 0.1 && geometry.horizontal_fov_rad < 3.0 &&
+      geometry.vertical_fov_rad > 0.1 && geometry.vertical_fov_rad < 3.0) {
+    intrinsics_ = CameraIntrinsics::FromFieldOfView(
+        depth_->width, depth_->height, geometry.horizontal_fov_rad, geometry.vertical_fov_rad);
+  } else {
+    intrinsics_ = CameraIntrinsics::Carmine109().Scaled(depth_->width, depth_->height);
+  }
+  mapping_ = std::move(mapping);
+  next_ = 0;
+  color_cursor_ = 0;
+  delivered_ = 0;
+  skipped_ = 0;
+}
+
+void OniFileSource::Stop() { mapping_.reset(); }
+
+SourceRead OniFileSource::Next(std::chrono::milliseconds) {
+  IHS_CHECK(mapping_ != nullptr, "OniFileSource::Next called before Start");
+  const std::string_view bytes = mapping_->bytes();
+  while (next_ < depth_->frames.size()) {
+    const OniFrameRecord& record = depth_->frames[next_++];
+    auto frame = std::make_shared<Frame>();
+    frame->width = depth_->width;
+    frame->height = depth_->height;
+    if (!DecodeOniDepth(bytes, *depth_, record, frame->depth_mm)) {
+      ++skipped_;
+      spdlog::warn("{}: skipping depth frame {}: its data cannot be decoded", path_.string(),
+                   record.frame_number);
+      continue;
+    }
+    frame->depth_timestamp_us = static_cast<std::int64_t>(record.timestamp_us);
+    if (color_ && !color_->frames.empty()) {
+      // Colour frames are in time order: advance while the next one is at least as close.
+      const auto& colors = color_->frames;
+      auto offset = [&](std::size_t k) {
+        return std::llabs(static_cast<std::int64_t>(colors[k].timestamp_us) -
+                          frame->depth_timestamp_us);
+      };
+      while (color_cursor_ + 1 < colors.size() &&
+             offset(color_cursor_ + 1) <= offset(color_cursor_)) {
+        ++color_cursor_;
+      }
+      if (offset(color_cursor_) <= max_color_offset_us_ &&
+          DecodeOniColor(bytes, *color_, colors[color_cursor_], frame->rgb)) {
+        frame->color_timestamp_us = static_cast<std::int64_t>(colors[color_cursor_].timestamp_us);
+      } else {
+        frame->rgb.clear();
+      }
+    }
+    frame->index = delivered_++;
+    return {SourceStatus::kFrame, std::move(frame), ""};
+  }
+  return {SourceStatus::kEndOfStream, nullptr, "end of " + path_.string()};
+}
+
+std::optional<std::int64_t> OniFileSource::FrameCount() const {
+  if (!depth_) return std::nullopt;
+  return static_cast<std::int64_t>(depth_->frames.size());
+}
+
+}  // namespace ihs::sensor

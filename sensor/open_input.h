@@ -1,0 +1,33 @@
+#pragma once
+// Opens whatever a user names as input: an .oni recording or a TUM RGB-D folder.
+
+#include <memory>
+#include <string>
+
+#include "sensor/frame_source.h"
+#include "sensor/tum_directory.h"
+
+namespace ihs::sensor {
+
+/// Which reader plays .oni files.
+enum class OniBackend {
+  kAuto,       ///< OpenNI2's player; the project's own reader when OpenNI2 refuses the file.
+  kOpenNi,     ///< OpenNI2's player only.
+  kOwnReader,  ///< The project's own reader only (recovers truncated recordings).
+};
+
+/// Options for opening an input.
+struct InputOptions {
+  /// As fast as possible (headless replay) or at the recorded pace.
+  Pacing pacing = Pacing::kAsFastAsPossible;
+  /// Reader for .oni files.
+  OniBackend oni_backend = OniBackend::kAuto;
+  /// Options for TUM folders (depth scale, association tolerance, intrinsics).
+  TumOptions tum;
+};
+
+/// A source for `input` (not yet started): an .oni file or a TUM folder. Throws ihs::InputError
+/// naming the input when it is neither.
+std::unique_ptr<FrameSource> OpenInput(const std::string& input, const InputOptions& options = {});
+
+}  // namespace ihs::sensor
