@@ -390,6 +390,13 @@ std::optional<std::int64_t> OpenNiSource::FrameCount() const {
 
 bool OpenNiSource::IsLive() const { return impl_ ? !impl_->is_file : !IsOniPath(options_.uri); }
 
+std::vector<openni::VideoStream*> OpenNiSource::OpenNiStreams() {
+  IHS_CHECK(impl_ != nullptr, "OpenNiSource::OpenNiStreams called before Start");
+  std::vector<openni::VideoStream*> streams = {&impl_->depth};
+  if (impl_->has_color) streams.push_back(&impl_->color);
+  return streams;
+}
+
 std::int64_t OpenNiSource::FramesWithoutColor() const { return impl_ ? impl_->without_color : 0; }
 
 }  // namespace ihs::sensor

@@ -6,8 +6,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "sensor/frame_source.h"
+
+namespace openni {
+class VideoStream;
+}
 
 namespace ihs::sensor {
 
@@ -53,6 +58,10 @@ class OpenNiSource : public FrameSource {
 
   /// Depth frames delivered without colour (no colour frame close enough in time).
   std::int64_t FramesWithoutColor() const;
+
+  /// The started OpenNI2 streams (depth, then colour if any), for openni::Recorder; OpenNI.h is
+  /// not needed to hold the pointers, so it stays out of this header.
+  std::vector<openni::VideoStream*> OpenNiStreams();
 
   /// Whether `uri` names an .oni recording (by extension).
   static bool IsOniPath(const std::string& uri);
