@@ -103,15 +103,13 @@ struct OpenNiSource::Impl : public openni::OpenNI::DeviceDisconnectedListener {
       openni::OpenNI::removeDeviceDisconnectedListener(this);
       listening = false;
     }
-    if (depth.isValid()) {
-      depth.stop();
-      depth.destroy();
-    }
-    if (color.isValid()) {
-      color.stop();
-      color.destroy();
-    }
+    if (depth.isValid()) depth.stop();
+    if (color.isValid()) color.stop();
+    // OpenNI2's file player keeps a thread that can still hand a frame to a stream being
+    // destroyed; closing the device first ends that thread.
     if (device.isValid()) device.close();
+    if (depth.isValid()) depth.destroy();
+    if (color.isValid()) color.destroy();
     if (runtime_acquired) {
       OpenNiRuntime::Release();
       runtime_acquired = false;
