@@ -11,6 +11,7 @@ if [[ ! -x "$build_dir/app/inhandscan" ]]; then
 demo: the build succeeded, but the scanning application (app/inhandscan) does not exist yet:
 demo: the sensor, tracker, fusion and application stages are still being built, so there is no
 demo: sample scan to run and no mesh to show. What is built so far (in $build_dir):
+demo:   tools/inhandscan-frames inspect and convert recordings (.oni, TUM RGB-D folders)
 demo:   tools/inhandscan-mesh   inspect and convert meshes (PLY, OBJ, STL)
 MSG
   exit 0

@@ -72,14 +72,17 @@ TEST(OpenNiSourceTest, MissingAndTruncatedFilesAreInputErrors) {
   const auto path = KinectRecording();
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent";
   const std::string bytes = test::ReadFileString(path);
-  test::WriteBytes(dir / "cut.oni", bytes.substr(0, bytes.size() / 2));
-  options.uri = (dir / "cut.oni").string();
-  try {
-    OpenNiSource(options).Start();
-    FAIL() << "OpenNI2 played a truncated file";
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("cut.oni: OpenNI2 cannot play it"), std::string::npos)
-        << error.what();
+  for (const double fraction : {0.1, 0.5, 0.9, 0.999}) {
+    test::WriteBytes(dir / "cut.oni", bytes.substr(0, static_cast<size_t>(bytes.size() * fraction)));
+    options.uri = (dir / "cut.oni").string();
+    try {
+      OpenNiSource(options).Start();
+      FAIL() << "OpenNI2 played a file cut at " << fraction;
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("cut.oni: OpenNI2 cannot play it"),
+                std::string::npos)
+          << error.what();
+    }
   }
 }
 
