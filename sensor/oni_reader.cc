@@ -119,6 +119,14 @@ void ApplyProperty(OniNode& node, std::uint32_t type, const std::string& name,
   }
 }
 
+// Whether the node has a plausible image size and the record's payload lies inside the file.
+bool FrameFits(std::string_view bytes, const OniNode& node, const OniFrameRecord& record) {
+  return node.width > 0 && node.height > 0 && node.width <= kMaxImageSide &&
+         node.height <= kMaxImageSide && record.payload_size <= kMaxFrameBytes &&
+         record.payload_offset <= bytes.size() &&
+         record.payload_size <= bytes.size() - record.payload_offset;
+}
+
 }  // namespace
 
 const OniNode* OniIndex::FirstOfType(OniNodeType type) const {
@@ -249,12 +257,7 @@ OniIndex IndexOni(std::string_view bytes, const std::string& name) {
 
 bool DecodeOniDepth(std::string_view bytes, const OniNode& node, const OniFrameRecord& record,
                     std::vector<std::uint16_t>& depth_mm) {
-  if (node.width <= 0 || node.height <= 0 || node.width > kMaxImageSide ||
-      node.height > kMaxImageSide || record.payload_size > kMaxFrameBytes ||
-      record.payload_offset > bytes.size() ||
-      record.payload_size > bytes.size() - record.payload_offset) {
-    return false;
-  }
+  if (!FrameFits(bytes, node, record)) return false;
   const std::size_t pixels = static_cast<std::size_t>(node.width) * node.height;
   const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data() + record.payload_offset);
   bool ok = false;
@@ -284,12 +287,7 @@ bool DecodeOniDepth(std::string_view bytes, const OniNode& node, const OniFrameR
 
 bool DecodeOniColor(std::string_view bytes, const OniNode& node, const OniFrameRecord& record,
                     std::vector<std::uint8_t>& rgb) {
-  if (node.width <= 0 || node.height <= 0 || node.width > kMaxImageSide ||
-      node.height > kMaxImageSide || record.payload_size > kMaxFrameBytes ||
-      record.payload_offset > bytes.size() ||
-      record.payload_size > bytes.size() - record.payload_offset || node.pixel_format != 200) {
-    return false;
-  }
+  if (!FrameFits(bytes, node, record) || node.pixel_format != 200) return false;
   const std::size_t size = static_cast<std::size_t>(node.width) * node.height * 3;
   const char* data = bytes.data() + record.payload_offset;
   if (node.codec == kOniCodecNone) {

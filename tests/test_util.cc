@@ -1,8 +1,10 @@
 #include "tests/test_util.h"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -42,6 +44,25 @@ std::filesystem::path SharedDataDir() {
   std::error_code ec;
   if (data.empty() || !std::filesystem::is_directory(data, ec)) return {};
   return std::filesystem::canonical(data, ec);
+}
+
+std::filesystem::path KinectRecording() {
+  const std::filesystem::path data = SharedDataDir();
+  return data.empty() ? data : data / "oni" / "kinect1-room-12frames.oni";
+}
+
+CommandResult RunCommand(const std::string& command) {
+  const TempDir dir;
+  const std::string full = command + " 2>'" + (dir / "stderr").string() + "'";
+  CommandResult result;
+  FILE* pipe = popen(full.c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) result.out.append(buffer, n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.err = ReadFileString(dir / "stderr");
+  return result;
 }
 
 std::string ReadFileString(const std::filesystem::path& path) {

@@ -34,6 +34,19 @@ class TempDir {
 /// an empty path when it is absent: tests that need it then GTEST_SKIP with that reason.
 std::filesystem::path SharedDataDir();
 
+/// The real Kinect v1 recording in the shared data, or an empty path when it is absent.
+std::filesystem::path KinectRecording();
+
+/// The result of running a shell command.
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  ///< Standard output.
+  std::string err;  ///< Standard error.
+};
+
+/// Runs `command` with /bin/sh, capturing stdout and stderr separately.
+CommandResult RunCommand(const std::string& command);
+
 /// Reads a whole file; empty if it cannot be read.
 std::string ReadFileString(const std::filesystem::path& path);
 

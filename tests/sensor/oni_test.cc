@@ -14,6 +14,7 @@
 #include "sensor/oni_writer.h"
 #include "sensor/openni_source.h"
 #include "tests/frame_fixtures.h"
+#include "tests/source_reading.h"
 #include "tests/test_util.h"
 
 namespace ihs::sensor {
@@ -21,31 +22,16 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::vector<std::shared_ptr<const Frame>> ReadAll(FrameSource& source) {
-  std::vector<std::shared_ptr<const Frame>> frames;
-  source.Start();
-  for (int timeouts = 0; timeouts < 20;) {
-    const SourceRead read = source.Next(2s);
-    if (read.status == SourceStatus::kTimeout) {
-      ++timeouts;
-      continue;
-    }
-    if (read.status != SourceStatus::kFrame) break;
-    frames.push_back(read.frame);
-  }
-  return frames;
-}
-
 std::vector<std::shared_ptr<const Frame>> ReadWithOpenNi(const std::filesystem::path& path) {
   OpenNiOptions options;
   options.uri = path.string();
   OpenNiSource source(options);
-  return ReadAll(source);
+  return test::ReadAllFrames(source);
 }
 
 std::vector<std::shared_ptr<const Frame>> ReadWithOwnReader(const std::filesystem::path& path) {
   OniFileSource source(path);
-  return ReadAll(source);
+  return test::ReadAllFrames(source);
 }
 
 void WriteOni(const std::filesystem::path& path, const std::vector<Frame>& frames,
@@ -109,13 +95,8 @@ TEST(OniWriterTest, RejectsFramesOfAnotherSizeAndUnwritablePaths) {
   EXPECT_THROW(OniWriter(dir / "missing" / "a.oni", options), OutputError);
 }
 
-std::filesystem::path KinectRecording() {
-  const std::filesystem::path data = test::SharedDataDir();
-  return data.empty() ? data : data / "oni" / "kinect1-room-12frames.oni";
-}
-
 TEST(OniReaderTest, AgreesWithOpenNi2BitForBitOnTheRealKinectRecording) {
-  const auto path = KinectRecording();
+  const auto path = test::KinectRecording();
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent";
   const auto ours = ReadWithOwnReader(path);
   const auto theirs = ReadWithOpenNi(path);
@@ -137,7 +118,7 @@ TEST(OniReaderTest, AgreesWithOpenNi2BitForBitOnTheRealKinectRecording) {
 }
 
 TEST(OniReaderTest, RecoversEveryCompleteFrameOfATruncatedRecording) {
-  const auto path = KinectRecording();
+  const auto path = test::KinectRecording();
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent";
   const std::string bytes = test::ReadFileString(path);
   const OniIndex full = IndexOni(bytes, "full");
@@ -154,7 +135,7 @@ TEST(OniReaderTest, RecoversEveryCompleteFrameOfATruncatedRecording) {
       expected += frame.payload_offset + frame.payload_size <= cut;
     }
     OniFileSource source(dir / "cut.oni");
-    const auto frames = ReadAll(source);
+    const auto frames = test::ReadAllFrames(source);
     EXPECT_TRUE(source.Recovered()) << cut;
     ASSERT_EQ(frames.size(), expected) << "cut at " << cut;
     for (size_t i = 0; i < frames.size(); ++i) {
@@ -187,7 +168,7 @@ TEST(OniReaderTest, RecoversOurOwnRecordingCutOffMidWrite) {
   std::filesystem::copy_file(dir / "live.oni", dir / "crashed.oni");
   writer.Close();
   OniFileSource source(dir / "crashed.oni");
-  ExpectSameFrames(ReadAll(source), frames);
+  ExpectSameFrames(test::ReadAllFrames(source), frames);
   EXPECT_TRUE(source.Recovered());
 }
 

@@ -15,11 +15,11 @@ using namespace std::chrono_literals;
 // OpenNI2's recorder works on any OpenNI2 device, including its file player: re-recording the
 // real Kinect recording exercises the whole path without a camera.
 TEST(OpenNiRecorderTest, RecordsARecordingThatBothReadersPlay) {
-  const std::filesystem::path data = test::SharedDataDir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
+  const std::filesystem::path kinect = test::KinectRecording();
+  if (kinect.empty()) GTEST_SKIP() << "../shared/data is absent";
   test::TempDir dir;
   OpenNiOptions device;
-  device.uri = (data / "oni" / "kinect1-room-12frames.oni").string();
+  device.uri = kinect.string();
   const std::atomic<bool> stop{false};
   const RecordingSummary summary = RecordWithOpenNi(device, dir / "again.oni", 20s, 0, stop);
   EXPECT_EQ(summary.depth_frames, 12);

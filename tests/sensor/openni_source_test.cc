@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "sensor/usb_devices.h"
+#include "tests/source_reading.h"
 #include "tests/test_util.h"
 
 namespace ihs::sensor {
@@ -14,13 +15,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::filesystem::path KinectRecording() {
-  const std::filesystem::path data = test::SharedDataDir();
-  return data.empty() ? data : data / "oni" / "kinect1-room-12frames.oni";
-}
-
 TEST(OpenNiSourceTest, PlaysTheRealKinectRecordingFrameByFrame) {
-  const auto path = KinectRecording();
+  const auto path = test::KinectRecording();
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent";
   OpenNiOptions options;
   options.uri = path.string();
@@ -69,11 +65,12 @@ TEST(OpenNiSourceTest, MissingAndTruncatedFilesAreInputErrors) {
   OpenNiOptions options;
   options.uri = (dir / "missing.oni").string();
   EXPECT_THROW(OpenNiSource(options).Start(), InputError);
-  const auto path = KinectRecording();
+  const auto path = test::KinectRecording();
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent";
   const std::string bytes = test::ReadFileString(path);
   for (const double fraction : {0.1, 0.5, 0.9, 0.999}) {
-    test::WriteBytes(dir / "cut.oni", bytes.substr(0, static_cast<size_t>(bytes.size() * fraction)));
+    test::WriteBytes(dir / "cut.oni",
+                     bytes.substr(0, static_cast<size_t>(bytes.size() * fraction)));
     options.uri = (dir / "cut.oni").string();
     try {
       OpenNiSource(options).Start();

@@ -6,24 +6,12 @@
 
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
+#include "tests/source_reading.h"
 
 namespace ihs::sensor {
 namespace {
 
 using namespace std::chrono_literals;
-
-std::vector<std::shared_ptr<const Frame>> ReadAll(FrameSource& source, SourceStatus* end) {
-  std::vector<std::shared_ptr<const Frame>> frames;
-  while (true) {
-    SourceRead read = source.Next(1s);
-    if (read.status == SourceStatus::kTimeout) continue;
-    if (read.status != SourceStatus::kFrame) {
-      *end = read.status;
-      return frames;
-    }
-    frames.push_back(read.frame);
-  }
-}
 
 TEST(ReplaySourceTest, ServesFramesInOrderThenEndOfStream) {
   ReplaySource source(test::MakePatternFrames(5, 32, 24), CameraIntrinsics{});
@@ -31,7 +19,7 @@ TEST(ReplaySourceTest, ServesFramesInOrderThenEndOfStream) {
   EXPECT_EQ(source.FrameCount(), 5);
   EXPECT_FALSE(source.IsLive());
   SourceStatus end;
-  const auto frames = ReadAll(source, &end);
+  const auto frames = test::ReadAllFrames(source, &end);
   EXPECT_EQ(end, SourceStatus::kEndOfStream);
   ASSERT_EQ(frames.size(), 5u);
   for (int i = 0; i < 5; ++i) EXPECT_EQ(frames[i]->index, i);
@@ -47,7 +35,7 @@ TEST(ReplaySourceTest, InjectsDropsDuplicatesAndCorruptFrames) {
   ReplaySource source(test::MakePatternFrames(8, 32, 24), CameraIntrinsics{}, faults);
   source.Start();
   SourceStatus end;
-  const auto frames = ReadAll(source, &end);
+  const auto frames = test::ReadAllFrames(source, &end);
   ASSERT_EQ(frames.size(), 6u);
   std::vector<std::int64_t> indices;
   for (const auto& frame : frames) indices.push_back(frame->index);
@@ -65,7 +53,7 @@ TEST(ReplaySourceTest, DisconnectsAfterNFramesAndKeepsDeliveredFramesValid) {
   source.Start();
   EXPECT_TRUE(source.IsLive());
   SourceStatus end;
-  const auto frames = ReadAll(source, &end);
+  const auto frames = test::ReadAllFrames(source, &end);
   EXPECT_EQ(end, SourceStatus::kDisconnected);
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_EQ(frames[2]->DepthAt(5, 5), test::MakePatternFrame(2, 32, 24).DepthAt(5, 5));
@@ -93,7 +81,7 @@ TEST(ReplaySourceTest, WrapsAnotherSourceAndCountsItsFrames) {
   ReplaySource source(std::move(inner), faults);
   source.Start();
   SourceStatus end;
-  const auto frames = ReadAll(source, &end);
+  const auto frames = test::ReadAllFrames(source, &end);
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_EQ(frames.front()->index, 1);
   EXPECT_NE(source.Description().find("replay shim over replay shim"), std::string::npos);

@@ -7,23 +7,13 @@
 
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
+#include "tests/source_reading.h"
 #include "tests/test_util.h"
 
 namespace ihs::sensor {
 namespace {
 
 using namespace std::chrono_literals;
-
-std::vector<std::shared_ptr<const Frame>> ReadAll(FrameSource& source) {
-  std::vector<std::shared_ptr<const Frame>> frames;
-  source.Start();
-  while (true) {
-    SourceRead read = source.Next(1s);
-    if (read.status != SourceStatus::kFrame) break;
-    frames.push_back(read.frame);
-  }
-  return frames;
-}
 
 void WriteFrames(const std::filesystem::path& folder, const std::vector<Frame>& frames,
                  const CameraIntrinsics& intrinsics) {
@@ -40,7 +30,7 @@ TEST(TumDirectoryTest, RoundTripsDepthColourTimestampsAndIntrinsicsExactly) {
   WriteFrames(dir.path(), frames, intrinsics);
 
   TumDirectorySource source(dir.path());
-  const auto read = ReadAll(source);
+  const auto read = test::ReadAllFrames(source);
   ASSERT_EQ(read.size(), frames.size());
   EXPECT_EQ(source.FrameCount(), 4);
   EXPECT_DOUBLE_EQ(source.Intrinsics().fx, 52.123456789);
@@ -64,9 +54,9 @@ TEST(TumDirectoryTest, DepthScaleIsAppliedBothWays) {
     writer.Write(frame);
   }
   TumDirectorySource as_millimetres(dir.path(), options);
-  EXPECT_EQ(ReadAll(as_millimetres).at(0)->depth_mm, frame.depth_mm);
+  EXPECT_EQ(test::ReadAllFrames(as_millimetres).at(0)->depth_mm, frame.depth_mm);
   TumDirectorySource as_tum(dir.path());  // Read as 5000 per metre: 1 unit = 0.2 mm.
-  const auto scaled = ReadAll(as_tum).at(0);
+  const auto scaled = test::ReadAllFrames(as_tum).at(0);
   EXPECT_EQ(scaled->DepthAt(1, 1),
             static_cast<std::uint16_t>(std::lround(frame.DepthAt(1, 1) / 5.0)));
 }
@@ -87,7 +77,7 @@ TEST(TumDirectoryTest, MatchesByNearestTimestampWithoutAssociations) {
     EXPECT_LT(std::abs(entry.color_time_s - entry.depth_time_s), 0.0015);
   }
   TumDirectorySource source(dir.path());
-  EXPECT_EQ(ReadAll(source).size(), 4u);
+  EXPECT_EQ(test::ReadAllFrames(source).size(), 4u);
   EXPECT_EQ(source.UnmatchedDepth(), 1);
 }
 
@@ -97,7 +87,7 @@ TEST(TumDirectoryTest, UnreadableImagesAreSkippedAndCounted) {
   const auto entries = ListTumDirectory(dir.path(), TumOptions{});
   test::WriteBytes(dir / entries[1].depth_path, "not a png");
   TumDirectorySource source(dir.path());
-  const auto frames = ReadAll(source);
+  const auto frames = test::ReadAllFrames(source);
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(source.SkippedFrames(), 1);
   EXPECT_EQ(frames[1]->index, 1);  // Indices count delivered frames.

@@ -2,9 +2,7 @@
 // write and on the real Kinect recording, including damaged and unreadable input.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -17,23 +15,8 @@
 namespace ihs {
 namespace {
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-ToolRun RunTool(const std::string& arguments, const std::filesystem::path& stderr_file) {
-  const std::string command =
-      std::string(IHS_FRAMES_TOOL) + " " + arguments + " 2>'" + stderr_file.string() + "'";
-  ToolRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return run;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) run.out.append(buffer, n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.err = test::ReadFileString(stderr_file);
-  return run;
+test::CommandResult RunTool(const std::string& arguments) {
+  return test::RunCommand(std::string(IHS_FRAMES_TOOL) + " " + arguments);
 }
 
 TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
@@ -45,7 +28,7 @@ TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
     sensor::OniWriter writer(dir / "a.oni", options);
     for (const Frame& frame : frames) writer.Write(frame);
   }
-  const ToolRun info = RunTool("info --json " + (dir / "a.oni").string(), dir / "err");
+  const test::CommandResult info = RunTool("info --json " + (dir / "a.oni").string());
   ASSERT_EQ(info.exit_code, 0) << info.err;
   const auto json = nlohmann::json::parse(info.out);
   EXPECT_EQ(json["depth_frames"], 4);
@@ -59,12 +42,10 @@ TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
 
   // .oni → TUM → .oni gives back the same frames.
   ASSERT_EQ(
-      RunTool("-q convert " + (dir / "a.oni").string() + " " + (dir / "tum").string(), dir / "err")
-          .exit_code,
+      RunTool("-q convert " + (dir / "a.oni").string() + " " + (dir / "tum").string()).exit_code,
       0);
   ASSERT_EQ(
-      RunTool("-q convert " + (dir / "tum").string() + " " + (dir / "b.oni").string(), dir / "err")
-          .exit_code,
+      RunTool("-q convert " + (dir / "tum").string() + " " + (dir / "b.oni").string()).exit_code,
       0);
   sensor::OniFileSource source(dir / "b.oni");
   source.Start();
@@ -77,20 +58,20 @@ TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
 }
 
 TEST(FramesToolTest, DamagedRecordingConvertsWhatCanBeRecoveredAndSaysSo) {
-  const std::filesystem::path data = test::SharedDataDir();
-  if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
+  const std::filesystem::path kinect = test::KinectRecording();
+  if (kinect.empty()) GTEST_SKIP() << "../shared/data is absent";
   test::TempDir dir;
-  const std::string bytes = test::ReadFileString(data / "oni" / "kinect1-room-12frames.oni");
+  const std::string bytes = test::ReadFileString(kinect);
   test::WriteBytes(dir / "cut.oni", bytes.substr(0, bytes.size() * 2 / 3));
-  const ToolRun info = RunTool("info --json " + (dir / "cut.oni").string(), dir / "err");
+  const test::CommandResult info = RunTool("info --json " + (dir / "cut.oni").string());
   ASSERT_EQ(info.exit_code, 0) << info.err;
   const auto json = nlohmann::json::parse(info.out);
   EXPECT_EQ(json["recovered"], true);
   EXPECT_GE(json["depth_frames"].get<int>(), 6);
   EXPECT_LT(json["depth_frames"].get<int>(), 12);
   EXPECT_NE(info.err.find("recovered"), std::string::npos) << info.err;
-  const ToolRun convert =
-      RunTool("convert " + (dir / "cut.oni").string() + " " + (dir / "tum").string(), dir / "err");
+  const test::CommandResult convert =
+      RunTool("convert " + (dir / "cut.oni").string() + " " + (dir / "tum").string());
   EXPECT_EQ(convert.exit_code, 0) << convert.err;
   EXPECT_NE(convert.err.find("converted the"), std::string::npos) << convert.err;
 }
@@ -100,13 +81,13 @@ TEST(FramesToolTest, UnreadableInputsExitNonZeroWithOneLine) {
   test::WriteBytes(dir / "junk.oni", "junk");
   for (const std::string& input :
        {(dir / "junk.oni").string(), (dir / "none.oni").string(), (dir / "file.txt").string()}) {
-    const ToolRun run = RunTool("info " + input, dir / "err");
+    const test::CommandResult run = RunTool("info " + input);
     EXPECT_EQ(run.exit_code, 3) << input << ": " << run.err;
     EXPECT_NE(run.err.find("inhandscan-frames: error: "), std::string::npos) << run.err;
     EXPECT_NE(run.err.find(input), std::string::npos) << run.err;
     EXPECT_EQ(run.err.find("error:"), run.err.rfind("error:")) << run.err;
   }
-  EXPECT_EQ(RunTool("info --oni-reader magic x.oni", dir / "err").exit_code, 2);
+  EXPECT_EQ(RunTool("info --oni-reader magic x.oni").exit_code, 2);
 }
 
 }  // namespace

@@ -1,9 +1,7 @@
 // End-to-end tests of the inhandscan-mesh executable: output, exit codes, one-line errors.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <string>
 
 #include "core/mesh_io.h"
@@ -19,15 +17,8 @@ struct ToolRun {
 };
 
 ToolRun RunTool(const std::string& arguments) {
-  const std::string command = std::string(IHS_MESH_TOOL) + " " + arguments + " 2>&1";
-  ToolRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return run;
-  char buffer[4096];
-  while (size_t n = fread(buffer, 1, sizeof(buffer), pipe)) run.output.append(buffer, n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  const test::CommandResult result = test::RunCommand(std::string(IHS_MESH_TOOL) + " " + arguments);
+  return {result.exit_code, result.out + result.err};
 }
 
 int LineCount(const std::string& text) {
