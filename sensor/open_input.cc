@@ -30,14 +30,21 @@ class AutoOniSource : public FrameSource {
     auto openni = std::make_unique<OpenNiSource>(options);
     try {
       openni->Start();
-      active_ = std::move(openni);
-      return;
     } catch (const InputError& openni_error) {
       spdlog::info("{}; trying the built-in .oni reader", openni_error.what());
-      auto own = WithPacing(std::make_unique<OniFileSource>(path_), pacing_);
-      own->Start();  // Throws its own InputError when nothing can be recovered.
-      active_ = std::move(own);
+      openni.reset();
     }
+    if (openni && openni->FrameCount()) {
+      active_ = std::move(openni);
+      return;
+    }
+    if (openni) {
+      // No frame count: an unfinished recording, whose complete frames our reader knows exactly.
+      spdlog::info("{}: OpenNI2 reports no frame count; using the built-in .oni reader", path_);
+      openni->Stop();
+    }
+    active_ = WithPacing(std::make_unique<OniFileSource>(path_), pacing_);
+    active_->Start();  // Throws its own InputError when nothing can be recovered.
   }
   void Stop() override {
     if (active_) active_->Stop();

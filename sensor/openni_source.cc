@@ -37,6 +37,10 @@ class OpenNiRuntime {
   static inline int users_ = 0;
 };
 
+// Longest pause of OpenNI2's player before a recording counts as ended (its own pacing never
+// sleeps more than 2 s between frames).
+constexpr auto kRecordingSilence = std::chrono::seconds(5);
+
 std::string ExtendedError() {
   const char* text = openni::OpenNI::getExtendedError();
   return text && *text ? text : "OpenNI2 gave no reason";
@@ -82,7 +86,10 @@ struct OpenNiSource::Impl : public openni::OpenNI::DeviceDisconnectedListener {
   std::string uri;
   std::string description;
   CameraIntrinsics intrinsics;
-  int depth_frame_count = -1;  // Recordings only.
+  int depth_frame_count = -1;  // Recordings only; -1 when the file does not say.
+  // When the player last delivered anything: a recording whose frame count is unknown or wrong
+  // just stops delivering at its end (or at damage), so a long silence ends it.
+  std::chrono::steady_clock::time_point last_activity;
   std::int64_t depth_frames_read = 0;
   std::int64_t delivered = 0;
   std::int64_t without_color = 0;
@@ -230,6 +237,7 @@ void OpenNiSource::Start() {
     intrinsics = CameraIntrinsics::Carmine109().Scaled(width, height);
   }
   impl->intrinsics = *intrinsics;
+  impl->last_activity = std::chrono::steady_clock::now();
   impl_ = std::move(impl);
 }
 
@@ -334,6 +342,12 @@ SourceRead OpenNiSource::Next(std::chrono::milliseconds timeout) {
         return {SourceStatus::kEndOfStream, nullptr, "end of " + options_.uri};
       }
       if (status == openni::STATUS_TIME_OUT) {
+        if (s.is_file && std::chrono::steady_clock::now() - s.last_activity > kRecordingSilence) {
+          if (s.held_depth) return deliver();
+          return {SourceStatus::kEndOfStream, nullptr,
+                  "end of " + options_.uri + ": the player stopped delivering frames after " +
+                      std::to_string(s.depth_frames_read) + " (damaged or unfinished recording?)"};
+        }
         if (std::chrono::steady_clock::now() < deadline) continue;
         return {SourceStatus::kTimeout, nullptr, ""};
       }
@@ -345,6 +359,7 @@ SourceRead OpenNiSource::Next(std::chrono::milliseconds timeout) {
               "end of " + options_.uri + ": " + ExtendedError()};
     }
     openni::VideoFrameRef ref;
+    s.last_activity = std::chrono::steady_clock::now();
     if (streams[ready]->readFrame(&ref) != openni::STATUS_OK || !ref.isValid()) {
       if (!s.is_file) {
         return {SourceStatus::kDisconnected, nullptr,
