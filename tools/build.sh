@@ -4,6 +4,7 @@
 #   IHS_BUILD_TYPE  CMake build type (default: Release)
 #   IHS_SANITIZE    "", "address,undefined" or "thread": a sanitizer build
 #   IHS_JOBS        parallel jobs (default: number of cores)
+#   IHS_TARGETS     space-separated targets to build (default: all)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/tools/install-deps.sh"
@@ -20,4 +21,6 @@ if [[ ! -f "$build_dir/CMakeCache.txt" ]] && command -v ninja >/dev/null 2>&1; t
 fi
 cmake -S "$root" -B "$build_dir" "${generator[@]}" \
   -DCMAKE_BUILD_TYPE="$build_type" -DIHS_SANITIZE="$sanitize" >/dev/null
-cmake --build "$build_dir" --parallel "$jobs"
+targets=()
+for target in ${IHS_TARGETS:-}; do targets+=(--target "$target"); done
+cmake --build "$build_dir" --parallel "$jobs" "${targets[@]}"
