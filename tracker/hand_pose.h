@@ -1,0 +1,44 @@
+#pragma once
+// The pose parameters of a hand model — a rigid root transform plus one angle per active joint
+// degree of freedom — and forward kinematics from them to every bone's cam_from_bone.
+
+#include <vector>
+
+#include "core/rigid3.h"
+#include "tracker/hand_model.h"
+
+namespace ihs::tracker {
+
+/// One rotational degree of freedom: bone `bone` rotates about its `axis`-th limit axis.
+struct DegreeOfFreedom {
+  int bone = 0;
+  int axis = 0;
+};
+
+/// The active joint degrees of freedom of `model` (root excluded), in bone order then axis order
+/// (x, y, z): the layout of HandPose::angles_rad.
+std::vector<DegreeOfFreedom> JointDegreesOfFreedom(const HandModel& model);
+
+/// A hand pose: the root bone's transform and the joint angles (radians, zero = rest pose).
+struct HandPose {
+  /// cam_from_bone of the root bone (forearm/palm).
+  Rigid3 cam_from_root;
+  /// One angle per JointDegreesOfFreedom entry, radians.
+  std::vector<double> angles_rad;
+
+  /// The rest pose of `model` placed by `cam_from_model`.
+  static HandPose Rest(const HandModel& model, const Rigid3& cam_from_model = Rigid3());
+};
+
+/// Forward kinematics: cam_from_bone for every bone. A bone's rotation relative to its rest
+/// placement on its parent is R = Rx(θx)·Ry(θy)·Rz(θz) about its (active) limit axes.
+std::vector<Rigid3> ForwardKinematics(const HandModel& model, const HandPose& pose);
+
+/// Joint angles that explain given bone transforms: each bone's rotation relative to its rest
+/// placement is decomposed onto its active axes in order, taking each axis's twist component
+/// (exact for single-axis joints and for rotations about the axes alone; an approximation for
+/// general multi-axis rotations, and rotation about inactive axes is dropped). Angles are not
+/// clamped to the limits. Used to initialise a fit from recorded motion.
+HandPose PoseFromBoneTransforms(const HandModel& model, const std::vector<Rigid3>& cam_from_bone);
+
+}  // namespace ihs::tracker
