@@ -1,0 +1,73 @@
+#include "tracker/procedural_hand.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "render/offscreen_renderer.h"
+#include "tracker/hand_pose.h"
+
+namespace ihs::tracker {
+namespace {
+
+TEST(ProceduralHandTest, HasTheRealModelsTopologyAndAClosedMesh) {
+  const HandModel hand = MakeProceduralHand();
+  ASSERT_EQ(hand.bones.size(), 20u);
+  EXPECT_EQ(hand.bones[0].name, "Lower Arm R");
+  for (const char* name : {"RFing.0_2", "RFing.3_Hand", "RFing.4_1"}) {
+    EXPECT_GE(hand.BoneIndex(name), 0) << name;
+  }
+  std::vector<std::string> ends;
+  for (int end : hand.EndEffectors()) ends.push_back(hand.bones[end].name);
+  EXPECT_EQ(ends, (std::vector<std::string>{"RFing.0_2", "RFing.1_2", "RFing.2_2", "RFing.3_2",
+                                            "RFing.4_1"}));
+  EXPECT_EQ(JointDegreesOfFreedom(hand).size(), 26u);
+  EXPECT_GT(hand.rest_mesh.vertices.size(), 2000u);
+  EXPECT_LT(hand.rest_mesh.vertices.size(), 8000u);
+  EXPECT_TRUE(hand.rest_mesh.IsWatertight());
+  EXPECT_GT(hand.rest_mesh.Volume(), 1e5);  // Outward faces; an adult hand is ~400 cm³.
+  const auto [lo, hi] = hand.rest_mesh.Bounds();
+  EXPECT_NEAR(hi.z() - lo.z(), 17.6 + 76 + 38 + 26 + 22, 40);  // Wrist to middle fingertip.
+}
+
+TEST(ProceduralHandTest, FlexionBendsFingersTowardThePalmAndKeepsTheSurface) {
+  const HandModel hand = MakeProceduralHand();
+  const auto dofs = JointDegreesOfFreedom(hand);
+  HandPose pose = HandPose::Rest(hand);
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    if (dofs[k].axis == 1) pose.angles_rad[k] = -0.6;  // Flex every joint by 34°.
+  }
+  const auto bones = ForwardKinematics(hand, pose);
+  const auto rest_joints = hand.JointPositions(ForwardKinematics(hand, HandPose::Rest(hand)));
+  const auto joints = hand.JointPositions(bones);
+  for (int end : hand.EndEffectors()) {
+    EXPECT_GT(joints[end + 1].y() - rest_joints[end + 1].y(), 20) << hand.bones[end].name;
+  }
+  const TriangleMesh posed = hand.Pose(bones);
+  std::vector<double> stretch;
+  for (const auto& face : posed.faces) {
+    const double a = (hand.rest_mesh.vertices[face[0]] - hand.rest_mesh.vertices[face[1]]).norm();
+    const double b = (posed.vertices[face[0]] - posed.vertices[face[1]]).norm();
+    stretch.push_back(std::abs(b - a) / a);
+  }
+  std::sort(stretch.begin(), stretch.end());
+  EXPECT_LT(stretch[stretch.size() / 2], 0.01);
+}
+
+TEST(ProceduralHandTest, RendersAsAHandSizedBlobInFrontOfTheCamera) {
+  const HandModel hand = MakeProceduralHand();
+  render::OffscreenRenderer renderer(CameraIntrinsics{});
+  render::RenderItem item{&hand.rest_mesh,
+                          Rigid3::FromAxisAngle({1, 0, 0}, -M_PI / 2, {0, 0, 600}),
+                          {220, 170, 140},
+                          false,
+                          render::kHand};
+  const render::RenderOutput out = renderer.Render({item});
+  const long hand_pixels = std::count(out.labels.begin(), out.labels.end(), render::kHand);
+  // Palm toward the camera at 60 cm: roughly 90 × 180 mm → ~12 000 px at f = 525.
+  EXPECT_GT(hand_pixels, 6000);
+  EXPECT_LT(hand_pixels, 25000);
+}
+
+}  // namespace
+}  // namespace ihs::tracker

@@ -1,0 +1,174 @@
+#include "tracker/procedural_hand.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+
+#include "core/check.h"
+
+namespace ihs::tracker {
+namespace {
+
+// A bone frame at `start` whose x axis is `direction` and whose y (flexion) axis lies in the
+// palm plane, so that negative flexion bends toward the palm (+y).
+Rigid3 BoneFrame(const Eigen::Vector3d& start, const Eigen::Vector3d& direction) {
+  const Eigen::Vector3d x = direction.normalized();
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY().cross(x).normalized();
+  Eigen::Matrix3d rotation;
+  rotation.col(0) = x;
+  rotation.col(1) = y;
+  rotation.col(2) = x.cross(y);
+  return Rigid3(rotation, start);
+}
+
+JointLimits Limits(std::array<std::pair<double, double>, 3> ranges_deg) {
+  JointLimits limits;
+  limits.limits_deg = ranges_deg;
+  for (int k = 0; k < 3; ++k) limits.active[k] = ranges_deg[k].first != ranges_deg[k].second;
+  return limits;
+}
+
+// Appends a closed capsule around bone `bone` (length `length`, radius `radius`, flattened
+// across the palm by `flatten`), skinned to the bone and, near its start, to its parent.
+void AppendCapsule(HandModel& model, int bone, double length, double radius, double flatten,
+                   int segments) {
+  TriangleMesh& mesh = model.rest_mesh;
+  const Rigid3& model_from_bone = model.model_from_bone_rest[bone];
+  const int parent = model.bones[bone].parent;
+  // Profile along the bone: (x, ring radius) from pole to pole.
+  std::vector<std::pair<double, double>> profile;
+  const int cap_rings = 4;
+  for (int i = 1; i <= cap_rings; ++i) {
+    const double a = M_PI / 2 * i / cap_rings;  // From the start pole to the equator.
+    profile.emplace_back(-radius * std::cos(a), radius * std::sin(a));
+  }
+  const int body_rings = std::max(2, static_cast<int>(std::ceil(length / (radius * 0.8))));
+  for (int i = 1; i < body_rings; ++i) profile.emplace_back(length * i / body_rings, radius);
+  for (int i = 0; i < cap_rings; ++i) {
+    const double a = M_PI / 2 * i / cap_rings;
+    profile.emplace_back(length + radius * std::sin(a), radius * std::cos(a));
+  }
+  auto weights_at = [&](double x) {
+    VertexWeights weights;
+    const double s = x / length;
+    const double to_parent =
+        parent < 0 ? 0.0 : (s < 0.25 ? 0.5 * (1 - std::max(0.0, s) / 0.25) : 0.0);
+    weights.bones.emplace_back(bone, static_cast<float>(1 - to_parent));
+    if (to_parent > 0) weights.bones.emplace_back(parent, static_cast<float>(to_parent));
+    return weights;
+  };
+  auto add = [&](const Eigen::Vector3d& in_bone) {
+    mesh.vertices.push_back((model_from_bone * in_bone).cast<float>());
+    model.weights.push_back(weights_at(in_bone.x()));
+    return static_cast<std::int32_t>(mesh.vertices.size() - 1);
+  };
+  const std::int32_t start_pole = add({-radius, 0, 0});
+  const auto first_ring = static_cast<std::int32_t>(mesh.vertices.size());
+  for (const auto& [x, r] : profile) {
+    for (int k = 0; k < segments; ++k) {
+      const double phi = 2 * M_PI * k / segments;
+      add({x, r * std::cos(phi), flatten * r * std::sin(phi)});
+    }
+  }
+  const std::int32_t end_pole = add({length + radius, 0, 0});
+  const int rings = static_cast<int>(profile.size());
+  auto at = [&](int ring, int k) { return first_ring + ring * segments + (k % segments); };
+  // Outward orientation: the bone axis runs along +x, rings turn from y toward z.
+  for (int k = 0; k < segments; ++k) {
+    mesh.faces.push_back({start_pole, at(0, k + 1), at(0, k)});
+    mesh.faces.push_back({end_pole, at(rings - 1, k), at(rings - 1, k + 1)});
+    for (int ring = 0; ring + 1 < rings; ++ring) {
+      mesh.faces.push_back({at(ring, k), at(ring, k + 1), at(ring + 1, k + 1)});
+      mesh.faces.push_back({at(ring, k), at(ring + 1, k + 1), at(ring + 1, k)});
+    }
+  }
+}
+
+}  // namespace
+
+void ProceduralHandOptions::Check() const {
+  IHS_CHECK_ARG(scale > 0.2 && scale < 5, "hand.scale must be in (0.2, 5), got " << scale);
+  IHS_CHECK_ARG(wrist_length_mm > 0, "hand.wrist_length_mm must be positive");
+  for (const auto& finger : finger_lengths_mm) {
+    for (double length : finger)
+      IHS_CHECK_ARG(length > 0, "hand.finger_lengths_mm must be positive");
+  }
+  for (double length : thumb_lengths_mm)
+    IHS_CHECK_ARG(length > 0, "hand.thumb_lengths_mm must be positive");
+  for (double radius : finger_radius_mm)
+    IHS_CHECK_ARG(radius > 0, "hand.finger_radius_mm must be positive");
+  IHS_CHECK_ARG(segments >= 6 && segments <= 64,
+                "hand.segments must be in [6, 64], got " << segments);
+}
+
+HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
+  options.Check();
+  const double s = options.scale;
+  HandModel model;
+  auto add_bone = [&](const std::string& name, int parent, double length, const Rigid3& frame,
+                      JointLimits limits) {
+    model.bones.push_back({name, parent, length});
+    model.model_from_bone_rest.push_back(frame);
+    model.limits.push_back(limits);
+    return static_cast<int>(model.bones.size() - 1);
+  };
+  // Root: the wrist, ending where the metacarpals start; a free rigid body.
+  JointLimits root;
+  root.translation = true;
+  root.active = {true, true, true};
+  root.limits_deg = {{{-180, 180}, {-180, 180}, {-180, 180}}};
+  const double wrist = options.wrist_length_mm * s;
+  add_bone("Lower Arm R", -1, wrist, BoneFrame({0, 0, -wrist}, Eigen::Vector3d::UnitZ()), root);
+
+  // Fingers 0..3 (pinky to index): metacarpals fan out from the wrist to the knuckles.
+  const double base_x[4] = {-15, -5, 5, 15}, knuckle_x[4] = {-30, -10, 10, 30};
+  for (int f = 0; f < 4; ++f) {
+    const auto& lengths = options.finger_lengths_mm[f];
+    const std::string prefix = "RFing." + std::to_string(f) + "_";
+    const Eigen::Vector3d start(base_x[f] * s, 0, 0);
+    const Eigen::Vector3d knuckle(knuckle_x[f] * s, 0, lengths[0] * s);
+    const Eigen::Vector3d direction = (knuckle - start).normalized();
+    Rigid3 frame = BoneFrame(start, direction);
+    int parent = 0;
+    const JointLimits joint_limits[4] = {
+        Limits({{{0, 0}, {-10, 1}, {0, 0}}}), Limits({{{0, 0}, {-95, 20}, {-15, 30}}}),
+        Limits({{{0, 0}, {-100, 10}, {0, 0}}}), Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
+    const char* names[4] = {"Hand", "0", "1", "2"};
+    for (int k = 0; k < 4; ++k) {
+      const double length = (k == 0 ? (knuckle - start).norm() : lengths[k] * s);
+      parent = add_bone(prefix + names[k], parent, length, frame, joint_limits[k]);
+      frame = frame * Rigid3::Translation({length, 0, 0});  // The child starts at the end.
+    }
+  }
+  // Thumb: from the side of the wrist, toward +x and forward, turned toward the palm.
+  {
+    const Eigen::Vector3d start(18 * s, 4 * s, 5 * s);
+    Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, 0.25, 0.6));
+    const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-30, 40}}}),
+                                         Limits({{{0, 0}, {-60, 10}, {-15, 15}}}),
+                                         Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
+    const char* names[3] = {"Hand", "0", "1"};
+    int parent = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double length = options.thumb_lengths_mm[k] * s;
+      parent = add_bone(std::string("RFing.4_") + names[k], parent, length, frame, joint_limits[k]);
+      frame = frame * Rigid3::Translation({length, 0, 0});
+    }
+  }
+
+  // Skin: the wrist and the palm (metacarpals) as broad, flat capsules; fingers round.
+  AppendCapsule(model, 0, wrist, 24 * s, 0.45, options.segments);
+  for (int bone = 1; bone < static_cast<int>(model.bones.size()); ++bone) {
+    const std::string& name = model.bones[bone].name;
+    const int finger = name[6] - '0';
+    const bool metacarpal = name.size() >= 4 && name.substr(name.size() - 4) == "Hand";
+    const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : 1.0);
+    AppendCapsule(model, bone, model.bones[bone].length_mm, radius, metacarpal ? 0.6 : 0.9,
+                  options.segments);
+  }
+  model.rest_mesh.ComputeVertexNormals();
+  model.Check();
+  return model;
+}
+
+}  // namespace ihs::tracker
