@@ -31,7 +31,7 @@ class AutoOniSource : public FrameSource {
     try {
       openni->Start();
     } catch (const InputError& openni_error) {
-      spdlog::info("{}; trying the built-in .oni reader", openni_error.what());
+      spdlog::debug("{}; trying the built-in .oni reader", openni_error.what());
       openni.reset();
     }
     if (openni && openni->FrameCount()) {
@@ -40,7 +40,7 @@ class AutoOniSource : public FrameSource {
     }
     if (openni) {
       // No frame count: an unfinished recording, whose complete frames our reader knows exactly.
-      spdlog::info("{}: OpenNI2 reports no frame count; using the built-in .oni reader", path_);
+      spdlog::debug("{}: OpenNI2 reports no frame count; using the built-in .oni reader", path_);
       openni->Stop();
     }
     active_ = WithPacing(std::make_unique<OniFileSource>(path_), pacing_);
