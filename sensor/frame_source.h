@@ -61,8 +61,8 @@ class FrameSource {
   virtual std::string Description() const = 0;
   /// Number of frames, when known (recordings); nullopt for live devices.
   virtual std::optional<std::int64_t> FrameCount() const = 0;
-  /// Whether this is a live device (frames must never be waited for by the capture thread's
-  /// consumer; dropping is allowed) rather than a recording.
+  /// Whether frames arrive in real time (a live device, or a recording paced at its timestamps):
+  /// a consumer that falls behind must then drop frames rather than block the capture thread.
   virtual bool IsLive() const = 0;
   /// Frames the source could not decode and skipped (each also logged with its reason).
   virtual std::int64_t SkippedFrames() const { return 0; }
