@@ -1,0 +1,51 @@
+#include "tracker/hand_joints_io.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "tests/test_util.h"
+#include "tracker/hand_pose.h"
+#include "tracker/procedural_hand.h"
+
+namespace ihs::tracker {
+namespace {
+
+TEST(HandJointsIoTest, RoundTripsTheJointsOfAPosedHandToATenthOfAMicrometre) {
+  const HandModel hand = MakeProceduralHand();
+  std::vector<std::string> names;
+  for (const Bone& bone : hand.bones) names.push_back(bone.name);
+  std::vector<HandJointsRow> rows;
+  for (int frame = 0; frame < 5; ++frame) {
+    const HandPose pose =
+        HandPose::Rest(hand, Rigid3::FromAxisAngle({0, 1, 0}, 0.2 * frame, {0, 0, 600}));
+    rows.push_back({frame, hand.JointPositions(ForwardKinematics(hand, pose))});
+  }
+  test::TempDir dir;
+  WriteHandJointsCsv(dir / "hand_joints.csv", names, rows);
+  const std::string text = test::ReadFileString(dir / "hand_joints.csv");
+  EXPECT_EQ(text.rfind("frame,Lower_Arm_R_start_x,Lower_Arm_R_start_y,", 0), 0u)
+      << text.substr(0, 80);
+  const auto read = ReadHandJointsCsv(dir / "hand_joints.csv");
+  ASSERT_EQ(read.size(), 5u);
+  for (size_t f = 0; f < read.size(); ++f) {
+    EXPECT_EQ(read[f].frame, rows[f].frame);
+    ASSERT_EQ(read[f].joints_mm.size(), 21u);
+    for (size_t j = 0; j < 21; ++j) {
+      EXPECT_LT((read[f].joints_mm[j] - rows[f].joints_mm[j]).norm(), 1e-4);
+    }
+  }
+  EXPECT_THROW(WriteHandJointsCsv(dir / "x.csv", names, {{0, {Eigen::Vector3d::Zero()}}}),
+               std::invalid_argument);
+}
+
+TEST(HandJointsIoTest, MalformedFilesAreInputErrors) {
+  test::TempDir dir;
+  for (const char* bytes :
+       {"", "x,y,z\n", "frame,a_x,a_y,a_z\n1,2,3\n", "frame,a_x,a_y,a_z\n1,2,three,4\n"}) {
+    test::WriteBytes(dir / "bad.csv", bytes);
+    EXPECT_THROW(ReadHandJointsCsv(dir / "bad.csv"), InputError) << bytes;
+  }
+}
+
+}  // namespace
+}  // namespace ihs::tracker

@@ -1,0 +1,91 @@
+#include "tracker/hand_joints_io.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/check.h"
+#include "core/errors.h"
+
+namespace ihs::tracker {
+
+void WriteHandJointsCsv(const std::filesystem::path& path,
+                        const std::vector<std::string>& bone_names,
+                        const std::vector<HandJointsRow>& rows) {
+  IHS_CHECK_ARG(!bone_names.empty(), "hand_joints.csv needs bone names");
+  std::string text = "frame";
+  for (size_t j = 0; j <= bone_names.size(); ++j) {
+    std::string name = j == 0 ? bone_names[0] + "_start" : bone_names[j - 1] + "_end";
+    for (char& c : name) {
+      if (c == ' ' || c == ',') c = '_';
+    }
+    for (const char* axis : {"_x", "_y", "_z"}) text += "," + name + axis;
+  }
+  text += "\n";
+  char number[64];
+  for (const HandJointsRow& row : rows) {
+    IHS_CHECK_ARG(row.joints_mm.size() == bone_names.size() + 1,
+                  "frame " << row.frame << " has " << row.joints_mm.size() << " joints, expected "
+                           << bone_names.size() + 1);
+    text += std::to_string(row.frame);
+    for (const Eigen::Vector3d& joint : row.joints_mm) {
+      for (int k = 0; k < 3; ++k) {
+        std::snprintf(number, sizeof(number), ",%.4f", joint[k]);
+        text += number;
+      }
+    }
+    text += "\n";
+  }
+  WriteFileAtomically(path, text);
+}
+
+std::vector<HandJointsRow> ReadHandJointsCsv(const std::filesystem::path& path) {
+  std::istringstream lines(ReadFileToString(path));
+  std::string line;
+  int number = 0;
+  size_t columns = 0;
+  std::vector<HandJointsRow> rows;
+  auto fail = [&](const std::string& why) -> void {
+    throw InputError(path.string() + ": line " + std::to_string(number) + ": " + why);
+  };
+  while (std::getline(lines, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    std::string field;
+    while (std::getline(split, field, ',')) fields.push_back(field);
+    if (columns == 0) {
+      if (fields.empty() || fields[0] != "frame" || (fields.size() - 1) % 3 != 0 ||
+          fields.size() < 4) {
+        fail("expected a header 'frame,<joint>_x,<joint>_y,<joint>_z,...'");
+      }
+      columns = fields.size();
+      continue;
+    }
+    if (fields.size() != columns) fail("expected " + std::to_string(columns) + " columns");
+    HandJointsRow row;
+    try {
+      size_t used = 0;
+      row.frame = std::stoll(fields[0], &used);
+      if (used != fields[0].size()) fail("bad frame number");
+      for (size_t c = 1; c < columns; c += 3) {
+        Eigen::Vector3d joint;
+        for (int k = 0; k < 3; ++k) {
+          joint[k] = std::stod(fields[c + k], &used);
+          if (used != fields[c + k].size() || !std::isfinite(joint[k])) fail("bad coordinate");
+        }
+        row.joints_mm.push_back(joint);
+      }
+    } catch (const std::logic_error&) {
+      fail("a field is not a number");
+    }
+    rows.push_back(std::move(row));
+  }
+  if (columns == 0) throw InputError(path.string() + ": empty, no header");
+  return rows;
+}
+
+}  // namespace ihs::tracker
