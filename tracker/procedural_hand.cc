@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "core/check.h"
@@ -28,41 +29,51 @@ JointLimits Limits(std::array<std::pair<double, double>, 3> ranges_deg) {
   return limits;
 }
 
-// Appends a closed capsule around bone `bone` (length `length`, radius `radius`, flattened
-// across the palm by `flatten`), skinned to the bone and, near its start, to its parent.
-void AppendCapsule(HandModel& model, int bone, double length, double radius, double flatten,
-                   int segments) {
-  TriangleMesh& mesh = model.rest_mesh;
-  const Rigid3& model_from_bone = model.model_from_bone_rest[bone];
+// Skinning weights as a function of a vertex's position in the model frame.
+using WeightFunction = std::function<VertexWeights(const Eigen::Vector3d& in_model)>;
+
+// Weights of a capsule around `bone`: the bone, blended into its parent over the first quarter.
+WeightFunction JointBlendWeights(const HandModel& model, int bone) {
   const int parent = model.bones[bone].parent;
-  // Profile along the bone: (x, ring radius) from pole to pole.
-  std::vector<std::pair<double, double>> profile;
-  const int cap_rings = 4;
-  for (int i = 1; i <= cap_rings; ++i) {
-    const double a = M_PI / 2 * i / cap_rings;  // From the start pole to the equator.
-    profile.emplace_back(-radius * std::cos(a), radius * std::sin(a));
-  }
-  const int body_rings = std::max(2, static_cast<int>(std::ceil(length / (radius * 0.8))));
-  for (int i = 1; i < body_rings; ++i) profile.emplace_back(length * i / body_rings, radius);
-  for (int i = 0; i < cap_rings; ++i) {
-    const double a = M_PI / 2 * i / cap_rings;
-    profile.emplace_back(length + radius * std::sin(a), radius * std::cos(a));
-  }
-  auto weights_at = [&](double x) {
+  const double length = model.bones[bone].length_mm;
+  const Rigid3 bone_from_model = model.model_from_bone_rest[bone].Inverse();
+  return [=](const Eigen::Vector3d& in_model) {
     VertexWeights weights;
-    const double s = x / length;
+    const double s = (bone_from_model * in_model).x() / length;
     const double to_parent =
         parent < 0 ? 0.0 : (s < 0.25 ? 0.5 * (1 - std::max(0.0, s) / 0.25) : 0.0);
     weights.bones.emplace_back(bone, static_cast<float>(1 - to_parent));
     if (to_parent > 0) weights.bones.emplace_back(parent, static_cast<float>(to_parent));
     return weights;
   };
-  auto add = [&](const Eigen::Vector3d& in_bone) {
-    mesh.vertices.push_back((model_from_bone * in_bone).cast<float>());
-    model.weights.push_back(weights_at(in_bone.x()));
+}
+
+// Appends a closed capsule along the x axis of `model_from_capsule`: a body of `length` and
+// `radius` (flattened along z by `flatten`) with half-ellipsoid caps reaching `cap` beyond
+// each end, skinned by `weights_of`.
+void AppendCapsule(HandModel& model, const Rigid3& model_from_capsule, double length, double radius,
+                   double cap, double flatten, int segments, const WeightFunction& weights_of) {
+  TriangleMesh& mesh = model.rest_mesh;
+  // Profile along the axis: (x, ring radius) from pole to pole.
+  std::vector<std::pair<double, double>> profile;
+  const int cap_rings = 4;
+  for (int i = 1; i <= cap_rings; ++i) {
+    const double a = M_PI / 2 * i / cap_rings;  // From the start pole to the equator.
+    profile.emplace_back(-cap * std::cos(a), radius * std::sin(a));
+  }
+  const int body_rings = std::max(2, static_cast<int>(std::ceil(length / (radius * 0.8))));
+  for (int i = 1; i < body_rings; ++i) profile.emplace_back(length * i / body_rings, radius);
+  for (int i = 0; i < cap_rings; ++i) {
+    const double a = M_PI / 2 * i / cap_rings;
+    profile.emplace_back(length + cap * std::sin(a), radius * std::cos(a));
+  }
+  auto add = [&](const Eigen::Vector3d& in_capsule) {
+    const Eigen::Vector3d in_model = model_from_capsule * in_capsule;
+    mesh.vertices.push_back(in_model.cast<float>());
+    model.weights.push_back(weights_of(in_model));
     return static_cast<std::int32_t>(mesh.vertices.size() - 1);
   };
-  const std::int32_t start_pole = add({-radius, 0, 0});
+  const std::int32_t start_pole = add({-cap, 0, 0});
   const auto first_ring = static_cast<std::int32_t>(mesh.vertices.size());
   for (const auto& [x, r] : profile) {
     for (int k = 0; k < segments; ++k) {
@@ -70,7 +81,7 @@ void AppendCapsule(HandModel& model, int bone, double length, double radius, dou
       add({x, r * std::cos(phi), flatten * r * std::sin(phi)});
     }
   }
-  const std::int32_t end_pole = add({length + radius, 0, 0});
+  const std::int32_t end_pole = add({length + cap, 0, 0});
   const int rings = static_cast<int>(profile.size());
   auto at = [&](int ring, int k) { return first_ring + ring * segments + (k % segments); };
   // Outward orientation: the bone axis runs along +x, rings turn from y toward z.
@@ -156,15 +167,43 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     }
   }
 
-  // Skin: the wrist and the palm (metacarpals) as broad, flat capsules; fingers round.
-  AppendCapsule(model, 0, wrist, 24 * s, 0.45, options.segments);
+  // Skin. The palm: one flat capsule from the wrist to the knuckles, each point skinned to
+  // the metacarpals nearest across the palm (and to the wrist near its start).
+  const int segments = options.segments;
+  const double palm_length = 58 * s, palm_radius = 36 * s;
+  std::array<int, 4> metacarpals;
+  for (int f = 0; f < 4; ++f)
+    metacarpals[f] = model.BoneIndex("RFing." + std::to_string(f) + "_Hand");
+  const WeightFunction palm_weights = [&](const Eigen::Vector3d& p) {
+    VertexWeights weights;
+    const double along = std::clamp(p.z() / (palm_length + 8 * s), 0.0, 1.0);
+    const double to_wrist = 0.5 * std::max(0.0, 1 - p.z() / (20 * s));
+    double raw[4], sum = 0;
+    for (int f = 0; f < 4; ++f) {
+      const double axis_x = (base_x[f] + (knuckle_x[f] - base_x[f]) * along) * s;
+      raw[f] = std::exp(-std::pow((p.x() - axis_x) / (12 * s), 2)) + 1e-6;
+      sum += raw[f];
+    }
+    for (int f = 0; f < 4; ++f) {
+      weights.bones.emplace_back(metacarpals[f], static_cast<float>((1 - to_wrist) * raw[f] / sum));
+    }
+    if (to_wrist > 0) weights.bones.emplace_back(0, static_cast<float>(to_wrist));
+    return weights;
+  };
+  AppendCapsule(model, BoneFrame({0, 0, 8 * s}, Eigen::Vector3d::UnitZ()), palm_length, palm_radius,
+                12 * s, 0.33, segments * 2, palm_weights);
+  // The wrist: a shorter, flat capsule on the root bone.
+  AppendCapsule(model, model.model_from_bone_rest[0], wrist, 28 * s, 10 * s, 0.45, segments * 2,
+                JointBlendWeights(model, 0));
+  // Fingers and thumb: round capsules on the phalanges and the thumb's metacarpal.
   for (int bone = 1; bone < static_cast<int>(model.bones.size()); ++bone) {
     const std::string& name = model.bones[bone].name;
     const int finger = name[6] - '0';
     const bool metacarpal = name.size() >= 4 && name.substr(name.size() - 4) == "Hand";
+    if (metacarpal && finger < 4) continue;  // Inside the palm.
     const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : 1.0);
-    AppendCapsule(model, bone, model.bones[bone].length_mm, radius, metacarpal ? 0.6 : 0.9,
-                  options.segments);
+    AppendCapsule(model, model.model_from_bone_rest[bone], model.bones[bone].length_mm, radius,
+                  radius, metacarpal ? 0.7 : 0.9, segments, JointBlendWeights(model, bone));
   }
   model.rest_mesh.ComputeVertexNormals();
   model.Check();
