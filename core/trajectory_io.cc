@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/atomic_file.h"
+#include "core/data_lines.h"
 #include "core/errors.h"
 
 namespace ihs {
@@ -28,15 +29,10 @@ void WriteTumTrajectory(const std::filesystem::path& path, const std::vector<Sta
 }
 
 std::vector<StampedPose> ReadTumTrajectory(const std::filesystem::path& path) {
-  std::istringstream lines(ReadFileToString(path));
   std::vector<StampedPose> poses;
-  std::string line;
-  int number = 0;
-  while (std::getline(lines, line)) {
-    ++number;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
+  for (const DataLine& line : ReadDataLines(path)) {
+    const int number = line.number;
+    std::istringstream fields(line.text);
     double v[8];
     for (double& value : v) {
       if (!(fields >> value) || !std::isfinite(value)) {

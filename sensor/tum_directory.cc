@@ -15,6 +15,7 @@
 
 #include "core/atomic_file.h"
 #include "core/check.h"
+#include "core/data_lines.h"
 #include "core/errors.h"
 
 namespace ihs::sensor {
@@ -28,19 +29,12 @@ struct Stamped {
 
 // Parses a TUM list: lines "timestamp path [...]", '#' comments, blank lines ignored.
 std::vector<Stamped> ReadList(const fs::path& file) {
-  std::istringstream lines(ReadFileToString(file));
   std::vector<Stamped> list;
-  std::string line;
-  int number = 0;
-  while (std::getline(lines, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
+  for (const DataLine& line : ReadDataLines(file)) {
+    std::istringstream fields(line.text);
     Stamped entry;
     if (!(fields >> entry.time_s >> entry.path) || !std::isfinite(entry.time_s)) {
-      throw InputError(file.string() + ": line " + std::to_string(number) +
+      throw InputError(file.string() + ": line " + std::to_string(line.number) +
                        " is not 'timestamp path'");
     }
     list.push_back(entry);
@@ -51,19 +45,13 @@ std::vector<Stamped> ReadList(const fs::path& file) {
 bool LooksLikeDepth(const std::string& path) { return path.rfind("depth", 0) == 0; }
 
 std::vector<TumEntry> ReadAssociations(const fs::path& file) {
-  std::istringstream lines(ReadFileToString(file));
   std::vector<TumEntry> entries;
-  std::string line;
-  int number = 0;
-  while (std::getline(lines, line)) {
-    ++number;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
+  for (const DataLine& line : ReadDataLines(file)) {
+    std::istringstream fields(line.text);
     double t1, t2;
     std::string p1, p2;
     if (!(fields >> t1 >> p1 >> t2 >> p2)) {
-      throw InputError(file.string() + ": line " + std::to_string(number) +
+      throw InputError(file.string() + ": line " + std::to_string(line.number) +
                        " is not 'time path time path'");
     }
     // associate.py writes the pair in the order of its arguments: usually rgb, then depth.

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "core/atomic_file.h"
 #include "core/check.h"
+#include "core/data_lines.h"
 #include "core/errors.h"
 
 namespace ihs::synth {
@@ -64,15 +64,10 @@ LatheProfile PaperObjectProfile(const std::string& name) {
 }
 
 LatheProfile ReadLatheProfile(const std::filesystem::path& path) {
-  std::istringstream lines(ReadFileToString(path));
   LatheProfile profile;
-  std::string line;
-  int number = 0;
-  while (std::getline(lines, line)) {
-    ++number;
-    const size_t first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#') continue;
-    std::istringstream fields(line);
+  for (const DataLine& line : ReadDataLines(path)) {
+    const int number = line.number;
+    std::istringstream fields(line.text);
     double z, r;
     std::string rest;
     if (!(fields >> z >> r) || (fields >> rest)) {

@@ -1,0 +1,24 @@
+#include "core/data_lines.h"
+
+#include <sstream>
+
+#include "core/atomic_file.h"
+
+namespace ihs {
+
+std::vector<DataLine> ReadDataLines(const std::filesystem::path& path) {
+  std::istringstream stream(ReadFileToString(path));
+  std::vector<DataLine> lines;
+  std::string text;
+  int number = 0;
+  while (std::getline(stream, text)) {
+    ++number;
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    const size_t first = text.find_first_not_of(" \t");
+    if (first == std::string::npos || text[first] == '#') continue;
+    lines.push_back({number, std::move(text)});
+  }
+  return lines;
+}
+
+}  // namespace ihs
