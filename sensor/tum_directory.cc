@@ -149,13 +149,17 @@ CameraIntrinsics ParseIntrinsics(const std::string& text) {
   std::stringstream fields(text);
   std::string field;
   while (std::getline(fields, field, ',')) {
+    size_t used = 0;
+    double value = 0;
     try {
-      size_t used = 0;
-      values.push_back(std::stod(field, &used));
-      IHS_CHECK_ARG(used == field.size(), "");
+      value = std::stod(field, &used);
     } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != field.size()) {
       throw std::invalid_argument("intrinsics '" + text + "': '" + field + "' is not a number");
     }
+    values.push_back(value);
   }
   IHS_CHECK_ARG(values.size() == 4 || values.size() == 6,
                 "intrinsics '" << text << "' must be fx,fy,cx,cy or fx,fy,cx,cy,width,height");

@@ -51,6 +51,11 @@ std::filesystem::path KinectRecording() {
   return data.empty() ? data : data / "oni" / "kinect1-room-12frames.oni";
 }
 
+std::filesystem::path HandDataDir() {
+  const std::filesystem::path data = SharedDataDir();
+  return data.empty() ? data : data / "hand-iccv15";
+}
+
 CommandResult RunCommand(const std::string& command) {
   const TempDir dir;
   const std::string full = command + " 2>'" + (dir / "stderr").string() + "'";

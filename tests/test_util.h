@@ -37,6 +37,9 @@ std::filesystem::path SharedDataDir();
 /// The real Kinect v1 recording in the shared data, or an empty path when it is absent.
 std::filesystem::path KinectRecording();
 
+/// The real hand data (shared/data/hand-iccv15), or an empty path when it is absent.
+std::filesystem::path HandDataDir();
+
 /// The result of running a shell command.
 struct CommandResult {
   int exit_code = -1;

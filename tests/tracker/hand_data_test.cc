@@ -12,13 +12,8 @@
 namespace ihs::tracker {
 namespace {
 
-std::filesystem::path HandData() {
-  const std::filesystem::path data = test::SharedDataDir();
-  return data.empty() ? data : data / "hand-iccv15";
-}
-
 TEST(HandDataTest, LoadsTheRealModelWithItsDocumentedShape) {
-  const auto data = HandData();
+  const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
   const RecordedHand hand = LoadRecordedHand(data, data / "sequences" / "001-water-bottle");
   const HandModel& model = hand.model;
@@ -42,7 +37,7 @@ TEST(HandDataTest, LoadsTheRealModelWithItsDocumentedShape) {
 }
 
 TEST(HandDataTest, RestRowReproducesTheRestMeshExactly) {
-  const auto data = HandData();
+  const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
   const RecordedHand hand = LoadRecordedHand(data, data / "sequences" / "004-sphere");
   const TriangleMesh posed = hand.model.Pose(hand.model.model_from_bone_rest);
@@ -56,7 +51,7 @@ TEST(HandDataTest, RestRowReproducesTheRestMeshExactly) {
 // Skinning with the recorded motion keeps the surface intact, puts the hand where the README says,
 // and puts each fingertip's end point just inside the tip of its finger.
 TEST(HandDataTest, RecordedMotionPosesAPlausibleHand) {
-  const auto data = HandData();
+  const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
   for (const char* session :
        {"001-water-bottle", "002-bowling-pin", "003-small-bottle", "004-sphere"}) {

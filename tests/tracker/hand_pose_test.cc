@@ -12,13 +12,8 @@
 namespace ihs::tracker {
 namespace {
 
-std::filesystem::path HandData() {
-  const std::filesystem::path data = test::SharedDataDir();
-  return data.empty() ? data : data / "hand-iccv15";
-}
-
 TEST(HandPoseTest, RestPoseReproducesTheRestTransforms) {
-  const auto data = HandData();
+  const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
   const HandModel model = LoadRecordedHand(data, data / "sequences" / "004-sphere").model;
   const auto dofs = JointDegreesOfFreedom(model);
@@ -33,7 +28,7 @@ TEST(HandPoseTest, RestPoseReproducesTheRestTransforms) {
 }
 
 TEST(HandPoseTest, AnglesRoundTripThroughForwardKinematics) {
-  const auto data = HandData();
+  const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
   const HandModel model = LoadRecordedHand(data, data / "sequences" / "004-sphere").model;
   const auto dofs = JointDegreesOfFreedom(model);
@@ -65,7 +60,7 @@ TEST(HandPoseTest, AnglesRoundTripThroughForwardKinematics) {
 // express of a real hand (the data's README: multi-axis joints leave their limits and the thumb
 // base twists although its twist axis is off).
 TEST(HandPoseTest, RecordedMotionIsExpressedWithinMillimetresAtTheFingertips) {
-  const auto data = HandData();
+  const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
   for (const char* session : {"001-water-bottle", "004-sphere"}) {
     const RecordedHand hand = LoadRecordedHand(data, data / "sequences" / session);
