@@ -6,11 +6,18 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${IHS_BUILD_DIR:-build}"
 [[ "$build_dir" = /* ]] || build_dir="$root/$build_dir"
 
+# The built-in sample: a synthetic sequence of the procedural hand turning a Ø70 mm sphere.
+sample="$build_dir/demo-sample"
+"$build_dir/tools/inhandscan-synth" --preset demo --out "$sample" --quiet
+echo "demo: sample sequence: $sample/sequence.oni (ground truth in $sample/gt/, a look at it:"
+echo "demo:   $sample/contact_sheet.png)"
+
 if [[ ! -x "$build_dir/app/inhandscan" ]]; then
   cat <<MSG
-demo: the build succeeded, but the scanning application (app/inhandscan) does not exist yet:
-demo: the sensor, tracker, fusion and application stages are still being built, so there is no
-demo: sample scan to run and no mesh to show. What is built so far (in $build_dir):
+demo: the scanning application (app/inhandscan) does not exist yet: the tracker, fusion and
+demo: application stages are still being built, so there is no mesh to show. What is built so far
+demo: (in $build_dir):
+demo:   tools/inhandscan-synth  render ground-truthed synthetic scanning sequences
 demo:   tools/inhandscan-frames inspect and convert recordings (.oni, TUM RGB-D folders)
 demo:   tools/inhandscan-mesh   inspect and convert meshes (PLY, OBJ, STL)
 MSG

@@ -25,6 +25,12 @@ std::vector<int> HandModel::EndEffectors() const {
   return ends;
 }
 
+int HandModel::FingerOf(int bone) const {
+  const std::string& name = bones.at(bone).name;
+  if (name.rfind("RFing.", 0) != 0 || name.size() < 7 || name[6] < '0' || name[6] > '4') return -1;
+  return name[6] - '0';
+}
+
 void HandModel::Check() const {
   const size_t n = bones.size();
   if (n == 0) throw InputError("hand model has no bones");

@@ -59,6 +59,9 @@ struct HandModel {
   int BoneIndex(const std::string& name) const;
   /// Indices of the end-effector bones (bones without children: the fingertip segments).
   std::vector<int> EndEffectors() const;
+  /// The finger a bone belongs to, by the data's naming "RFing.<f>_…": 0 pinky, 1 ring,
+  /// 2 middle, 3 index, 4 thumb; −1 for other bones (the root).
+  int FingerOf(int bone) const;
   /// Throws ihs::InputError describing the first inconsistency (sizes, parent order, weights).
   void Check() const;
 

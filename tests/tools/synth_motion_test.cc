@@ -1,0 +1,159 @@
+// Object shapes, the scripted and the recorded motions of the synthetic generator.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/errors.h"
+#include "tests/test_util.h"
+#include "tools/synth/hand_object.h"
+#include "tools/synth/object_shape.h"
+#include "tools/synth/recorded_motion.h"
+#include "tools/synth/scripted_motion.h"
+#include "tracker/hand_data.h"
+#include "tracker/procedural_hand.h"
+
+namespace ihs::synth {
+namespace {
+
+TEST(ObjectShapeTest, SignedDistanceOfTheSphereAndTheBox) {
+  const ObjectShape sphere = ObjectShape::FromSpec("sphere");
+  EXPECT_NEAR(sphere.SignedDistance({0, 0, 35}), -35, 0.01);  // A 90-segment profile.
+  EXPECT_NEAR(sphere.SignedDistance({50, 0, 35}), 15, 0.05);
+  EXPECT_NEAR(sphere.SignedDistance({0, 0, 80}), 10, 1e-6);
+  EXPECT_NEAR(sphere.SignedDistance({0, 0, -5}), 5, 1e-6);
+  EXPECT_NEAR(sphere.RadiusAt(35), 35, 0.01);
+  // Every mesh vertex lies on the surface.
+  for (const auto& v : sphere.mesh().vertices)
+    ASSERT_NEAR(sphere.SignedDistance(v.cast<double>()), 0, 1e-3);
+
+  const ObjectShape box = ObjectShape::FromSpec("box");
+  EXPECT_NEAR(box.SignedDistance({0, 0, 45}), -22.5, 1e-9);
+  EXPECT_NEAR(box.SignedDistance({40, 0, 45}), 10, 1e-9);
+  EXPECT_NEAR(box.SignedDistance({33, 0, 95}), std::sqrt(3.0 * 3 + 5 * 5), 1e-9);  // Edge.
+  EXPECT_TRUE(box.textured());
+  EXPECT_FALSE(box.rotationally_symmetric());
+
+  const ObjectShape bottle = ObjectShape::FromSpec("water-bottle");
+  EXPECT_NEAR(bottle.SignedDistance({0, 0, 100}), -36.5, 1e-9);  // Nearest: the side wall.
+  EXPECT_NEAR(bottle.SignedDistance({0, 0, 230}), 12, 1e-9);     // Above the cap.
+  EXPECT_NEAR(bottle.RadiusAt(100), 36.5, 1e-9);
+  EXPECT_THROW(ObjectShape::FromSpec("teapot"), std::invalid_argument);
+}
+
+// Angle (rad) of the rotation b·a⁻¹ about the object's own axis, signed.
+double TurnAboutAxis(const Rigid3& cam_from_object_a, const Rigid3& cam_from_object_b) {
+  const Eigen::Quaterniond q = (cam_from_object_a.Inverse() * cam_from_object_b).quaternion();
+  return 2 * std::atan2(q.z(), q.w());
+}
+
+TEST(ScriptedMotionTest, TurnsTheObjectAFullTurnHeldByThumbIndexAndMiddle) {
+  const tracker::HandModel hand = tracker::MakeProceduralHand();
+  const HandObjectGeometry geometry(hand);
+  for (const std::string name : {"sphere", "small-bottle", "box"}) {
+    SCOPED_TRACE(name);
+    const ObjectShape object = ObjectShape::FromSpec(name);
+    ScriptedMotionOptions options;
+    options.frames = 120;
+    const Motion motion = MakeScriptedMotion(hand, object, options);
+    ASSERT_EQ(motion.frames.size(), 120u);
+    double turn = 0, deepest = 0;
+    int held = 0;
+    for (size_t i = 0; i < motion.frames.size(); ++i) {
+      const MotionFrame& frame = motion.frames[i];
+      const TriangleMesh posed = hand.Pose(frame.cam_from_bone);
+      const HandObjectContact contact = geometry.Measure(posed, object, frame.cam_from_object, 1.0);
+      deepest = std::max(deepest, contact.max_penetration_mm);
+      if (frame.held) {
+        ++held;
+        // Thumb, index and middle touch (end-effector order: pinky, ring, middle, index, thumb).
+        EXPECT_TRUE(contact.fingertips[2].touching && contact.fingertips[3].touching &&
+                    contact.fingertips[4].touching)
+            << "frame " << i;
+      }
+      if (i > 0) {
+        const MotionFrame& before = motion.frames[i - 1];
+        if (!before.held || !frame.held) {
+          // Not held: the object does not move.
+          if (!frame.held) {
+            EXPECT_LT(before.cam_from_object.TranslationDistanceTo(frame.cam_from_object), 1e-6);
+          }
+        } else {
+          // Held: the object moves exactly with the hand (no slip).
+          const Rigid3 a = before.cam_from_object.Inverse() * before.cam_from_bone[0];
+          const Rigid3 b = frame.cam_from_object.Inverse() * frame.cam_from_bone[0];
+          EXPECT_LT(a.TranslationDistanceTo(b), 1e-6) << "frame " << i;
+          EXPECT_LT(a.RotationAngleToRad(b), 1e-9) << "frame " << i;
+        }
+        turn += TurnAboutAxis(before.cam_from_object, frame.cam_from_object);
+      }
+    }
+    EXPECT_GT(held, 60);
+    EXPECT_GE(std::abs(turn), 2 * M_PI - 0.05);
+    EXPECT_LT(deepest, 3.0);  // Fingertips press 0.5 mm; the box's corners may cut deeper.
+  }
+}
+
+TEST(ScriptedMotionTest, SlipTurnsTheObjectAgainstTheFingers) {
+  const tracker::HandModel hand = tracker::MakeProceduralHand();
+  const ObjectShape object = ObjectShape::FromSpec("sphere");
+  ScriptedMotionOptions options;
+  options.frames = 60;
+  options.slip_mm = 2.0;
+  const Motion motion = MakeScriptedMotion(hand, object, options);
+  double largest = 0;
+  for (size_t i = 1; i < motion.frames.size(); ++i) {
+    const auto& a = motion.frames[i - 1];
+    const auto& b = motion.frames[i];
+    if (!a.held || !b.held) continue;
+    const Rigid3 before = a.cam_from_object.Inverse() * a.cam_from_bone[0];
+    const Rigid3 after = b.cam_from_object.Inverse() * b.cam_from_bone[0];
+    largest = std::max(largest, before.RotationAngleToRad(after) * 35);  // mm at the surface.
+  }
+  EXPECT_GT(largest, 1.0);
+  EXPECT_LT(largest, 10.0);
+}
+
+TEST(RecordedMotionTest, FingertipsThatHoldTheObjectStayOnItsSurface) {
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
+  const tracker::RecordedHand recorded =
+      tracker::LoadRecordedHand(data, data / "sequences" / "004-sphere");
+  const ObjectShape object = ObjectShape::FromSpec("sphere");
+  RecordedMotionOptions options;
+  options.last_frame = 150;
+  RecordedMotionReport report;
+  const Motion motion = MakeRecordedMotion(recorded, object, options, &report);
+  ASSERT_EQ(motion.frames.size(), 151u);
+  EXPECT_GE(report.grasp_frame, 0);
+  EXPECT_GT(report.held_frames, 100);
+  EXPECT_GE(report.carried_within_3mm_share, 0.9);
+  EXPECT_GE(report.placed_within_3mm_share, 0.9);
+  EXPECT_LT(report.penetration_max_mm, 3.0);
+  // Independently: in held frames, at least two fingertips within 3 mm of the surface.
+  const HandObjectGeometry geometry(recorded.model);
+  int ok = 0, held = 0;
+  for (size_t t = 0; t < motion.frames.size(); t += 5) {
+    if (!motion.frames[t].held) continue;
+    ++held;
+    const TriangleMesh posed = recorded.model.Pose(motion.frames[t].cam_from_bone);
+    ok +=
+        geometry.Measure(posed, object, motion.frames[t].cam_from_object, 3.0).TouchingCount() >= 2;
+  }
+  EXPECT_GE(ok, 0.9 * held);
+}
+
+TEST(RecordedMotionTest, AnObjectThatNeverFitsTheGraspIsAnInputError) {
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
+  const tracker::RecordedHand recorded =
+      tracker::LoadRecordedHand(data, data / "sequences" / "004-sphere");
+  // A disc 300 mm across: no thumb–index gap matches its diameter.
+  const ObjectShape huge = ObjectShape::Lathe("disc", {{0, 150}, {5, 150}});
+  RecordedMotionOptions options;
+  options.last_frame = 20;
+  EXPECT_THROW(MakeRecordedMotion(recorded, huge, options, nullptr), InputError);
+}
+
+}  // namespace
+}  // namespace ihs::synth

@@ -1,0 +1,112 @@
+#include "tools/synth/object_shape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace ihs::synth {
+namespace {
+
+constexpr int kLatheSegments = 180;
+
+double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                       const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double s = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (p - (a + s * ab)).norm();
+}
+
+}  // namespace
+
+ObjectShape ObjectShape::FromSpec(const std::string& spec) {
+  if (spec == "box") return Box("box", Eigen::Vector3d(60, 45, 90));
+  if (spec.rfind("lathe:", 0) == 0) {
+    const std::string file = spec.substr(6);
+    if (file.empty()) throw std::invalid_argument("--object lathe:FILE needs a file name");
+    return Lathe(spec, ReadLatheProfile(file));
+  }
+  const auto names = PaperObjectNames();
+  if (std::find(names.begin(), names.end(), spec) == names.end()) {
+    throw std::invalid_argument("unknown object '" + spec +
+                                "' (sphere, water-bottle, bowling-pin, small-bottle, box, "
+                                "lathe:FILE)");
+  }
+  return Lathe(spec, PaperObjectProfile(spec));
+}
+
+ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& profile,
+                               std::array<std::uint8_t, 3> rgb) {
+  ObjectShape shape;
+  shape.name_ = name;
+  shape.mesh_ = MakeLatheMesh(profile, kLatheSegments, rgb);
+  shape.height_mm_ = profile.back().first - profile.front().first;
+  // The outline runs up the axis side closed by the end discs: (0, z0) … profile … (0, zn).
+  shape.outline_.emplace_back(0.0, profile.front().first);
+  for (const auto& [z, r] : profile) {
+    shape.outline_.emplace_back(r, z);
+    shape.max_radius_mm_ = std::max(shape.max_radius_mm_, r);
+  }
+  shape.outline_.emplace_back(0.0, profile.back().first);
+  return shape;
+}
+
+ObjectShape ObjectShape::Box(const std::string& name, const Eigen::Vector3d& size) {
+  ObjectShape shape;
+  shape.name_ = name;
+  shape.mesh_ = MakeTexturedBox(size);
+  shape.height_mm_ = size.z();
+  shape.max_radius_mm_ = size.head<2>().norm() / 2;
+  shape.textured_ = true;
+  shape.box_ = true;
+  shape.box_size_ = size;
+  return shape;
+}
+
+double ObjectShape::SignedDistance(const Eigen::Vector3d& p) const {
+  if (box_) {
+    const Eigen::Vector3d half = box_size_ / 2;
+    const Eigen::Vector3d q =
+        (p - Eigen::Vector3d(0, 0, half.z())).cwiseAbs() - half;  // Box centred at mid-height.
+    const double outside = q.cwiseMax(0.0).norm();
+    const double inside = std::min(q.maxCoeff(), 0.0);
+    return outside + inside;
+  }
+  // Distance to the outline in the (r, z) half-plane, skipping the segment along the axis (the
+  // last point back to the first), which is not a surface.
+  const Eigen::Vector2d q(p.head<2>().norm(), p.z());
+  double distance = std::numeric_limits<double>::infinity();
+  bool inside = false;
+  for (size_t i = 0; i + 1 < outline_.size(); ++i) {
+    const Eigen::Vector2d& a = outline_[i];
+    const Eigen::Vector2d& b = outline_[i + 1];
+    distance = std::min(distance, SegmentDistance(q, a, b));
+  }
+  // Inside test by crossings of a ray toward +r over the closed polygon (axis segment included).
+  for (size_t i = 0; i < outline_.size(); ++i) {
+    const Eigen::Vector2d& a = outline_[i];
+    const Eigen::Vector2d& b = outline_[(i + 1) % outline_.size()];
+    if ((a.y() > q.y()) != (b.y() > q.y())) {
+      const double r = a.x() + (q.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
+      if (q.x() < r) inside = !inside;
+    }
+  }
+  return inside ? -distance : distance;
+}
+
+double ObjectShape::RadiusAt(double z) const {
+  if (box_) return std::min(box_size_.x(), box_size_.y()) / 2;
+  double radius = 0;
+  for (size_t i = 1; i + 2 < outline_.size(); ++i) {
+    const Eigen::Vector2d& a = outline_[i];
+    const Eigen::Vector2d& b = outline_[i + 1];
+    if (z >= a.y() && z <= b.y()) {
+      const double s = b.y() > a.y() ? (z - a.y()) / (b.y() - a.y()) : 1.0;
+      radius = std::max(radius, a.x() + s * (b.x() - a.x()));
+    }
+  }
+  return radius;
+}
+
+}  // namespace ihs::synth

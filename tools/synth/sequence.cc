@@ -1,0 +1,337 @@
+#include "tools/synth/sequence.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "core/atomic_file.h"
+#include "core/check.h"
+#include "core/errors.h"
+#include "core/mesh_io.h"
+#include "core/trajectory_io.h"
+#include "render/offscreen_renderer.h"
+#include "sensor/oni_writer.h"
+#include "sensor/tum_directory.h"
+#include "tools/synth/hand_object.h"
+#include "tracker/hand_data.h"
+#include "tracker/hand_joints_io.h"
+#include "tracker/procedural_hand.h"
+
+namespace ihs::synth {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kFingerNames[5] = {"pinky", "ring", "middle", "index", "thumb"};
+
+// The first session folder (holding Model_Hand_R.MOTION) under `data_dir`/sequences.
+fs::path FirstSession(const fs::path& data_dir) {
+  std::vector<fs::path> sessions;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(data_dir / "sequences", error)) {
+    if (fs::exists(entry.path() / "Model_Hand_R.MOTION")) sessions.push_back(entry.path());
+  }
+  if (sessions.empty()) {
+    throw InputError(data_dir.string() +
+                     ": not a hand data folder (no sequences/*/Model_Hand_R.MOTION)");
+  }
+  std::sort(sessions.begin(), sessions.end());
+  return sessions.front();
+}
+
+// A colour-mapped depth image (near = warm, over the frame's own depth range), black where
+// there is no depth.
+cv::Mat DepthImage(const Frame& frame) {
+  cv::Mat depth(frame.height, frame.width, CV_16UC1,
+                const_cast<std::uint16_t*>(frame.depth_mm.data()));
+  double near = 0, far = 0;
+  cv::minMaxLoc(depth, nullptr, &far);
+  cv::Mat masked = depth.clone();
+  masked.setTo(65535, depth == 0);
+  cv::minMaxLoc(masked, &near);
+  const double range = std::max(1.0, far - near);
+  cv::Mat scaled;
+  depth.convertTo(scaled, CV_8UC1, -255.0 / range, 255.0 * far / range);
+  cv::Mat color;
+  cv::applyColorMap(scaled, color, cv::COLORMAP_JET);
+  color.setTo(cv::Scalar(0, 0, 0), depth == 0);
+  return color;
+}
+
+cv::Mat LabelImage(const std::vector<std::uint8_t>& labels, int width, int height) {
+  cv::Mat image(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const std::uint8_t label = labels[static_cast<size_t>(v) * width + u];
+      if (label == render::kHand) image.at<cv::Vec3b>(v, u) = cv::Vec3b(90, 150, 230);
+      if (label == render::kObject) image.at<cv::Vec3b>(v, u) = cv::Vec3b(220, 120, 40);
+    }
+  }
+  return image;
+}
+
+void WritePng(const fs::path& path, const cv::Mat& image) {
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", image, bytes)) throw OutputError(path.string() + ": cannot encode PNG");
+  WriteFileAtomically(path, std::string(bytes.begin(), bytes.end()));
+}
+
+json IntrinsicsJson(const CameraIntrinsics& c) {
+  return {{"fx", c.fx}, {"fy", c.fy},       {"cx", c.cx},
+          {"cy", c.cy}, {"width", c.width}, {"height", c.height}};
+}
+
+}  // namespace
+
+void SequenceOptions::Check() const {
+  IHS_CHECK_ARG(first_frame >= 0, "frames: the first frame must be >= 0");
+  IHS_CHECK_ARG(last_frame == -1 || last_frame >= first_frame,
+                "frames: the last frame must not come before the first");
+  IHS_CHECK_ARG(fps > 0 && fps <= 1000, "fps must be in (0, 1000]");
+  IHS_CHECK_ARG(touch_mm > 0, "touch_mm must be positive");
+  IHS_CHECK_ARG(motion == "scripted" || motion.rfind("recorded:", 0) == 0,
+                "motion must be 'scripted' or 'recorded:DIR', got '" << motion << "'");
+  intrinsics.Check();
+  sensor.Check();
+  scripted.Check();
+  recorded.Check();
+}
+
+SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path& out) {
+  options.Check();
+  const auto started = std::chrono::steady_clock::now();
+  const ObjectShape object = ObjectShape::FromSpec(options.object);
+
+  // The hand and its motion.
+  tracker::HandModel hand;
+  Motion motion;
+  RecordedMotionReport recorded_report;
+  const bool recorded = options.motion != "scripted";
+  if (recorded) {
+    const fs::path session = options.motion.substr(9);
+    const fs::path data_dir =
+        options.hand == "procedural" ? session.parent_path().parent_path() : fs::path(options.hand);
+    tracker::RecordedHand recording = tracker::LoadRecordedHand(data_dir, session);
+    RecordedMotionOptions recorded_options = options.recorded;
+    recorded_options.last_frame = options.last_frame;
+    motion = MakeRecordedMotion(recording, object, recorded_options, &recorded_report);
+    hand = std::move(recording.model);
+  } else {
+    if (options.hand == "procedural") {
+      hand = tracker::MakeProceduralHand();
+    } else {
+      hand = tracker::LoadRecordedHand(options.hand, FirstSession(options.hand)).model;
+    }
+    motion = MakeScriptedMotion(hand, object, options.scripted);
+  }
+  const int available = static_cast<int>(motion.frames.size());
+  const int last = options.last_frame < 0 ? available - 1 : options.last_frame;
+  if (options.first_frame >= available || last >= available) {
+    throw std::invalid_argument("frames " + std::to_string(options.first_frame) + ":" +
+                                std::to_string(last) +
+                                " outside the motion's 0:" + std::to_string(available - 1));
+  }
+
+  // Outputs.
+  const fs::path gt = out / "gt";
+  std::error_code error;
+  fs::create_directories(gt / "labels", error);
+  if (error) throw OutputError(gt.string() + ": cannot create (" + error.message() + ")");
+  std::unique_ptr<sensor::OniWriter> oni;
+  if (options.write_oni) {
+    sensor::OniWriterOptions oni_options;
+    oni_options.intrinsics = options.intrinsics;
+    oni_options.fps = options.fps;
+    oni = std::make_unique<sensor::OniWriter>(out / "sequence.oni", oni_options);
+  }
+  std::unique_ptr<sensor::TumWriter> tum;
+  if (options.write_tum) tum = std::make_unique<sensor::TumWriter>(out / "tum", options.intrinsics);
+
+  TriangleMesh object_mesh = object.mesh();
+  if (!object.textured())
+    object_mesh.colors.assign(object_mesh.vertices.size(), options.object_rgb);
+  render::OffscreenRenderer renderer(options.intrinsics);
+  const HandObjectGeometry geometry(hand);
+  std::mt19937 rng(options.seed);
+
+  std::vector<std::string> bone_names;
+  for (const auto& bone : hand.bones) bone_names.push_back(bone.name);
+  std::vector<StampedPose> trajectory;
+  std::vector<tracker::HandJointsRow> joints;
+  std::string contacts_csv = "frame,held";
+  std::vector<int> tip_fingers;
+  for (int bone : geometry.fingertip_bones()) tip_fingers.push_back(hand.FingerOf(bone));
+  for (int f : tip_fingers) contacts_csv += std::string(",") + kFingerNames[f] + "_touch";
+  for (int f : tip_fingers) contacts_csv += std::string(",") + kFingerNames[f] + "_mm";
+  contacts_csv += ",penetration_mm\n";
+
+  SequenceSummary summary;
+  const int count = last - options.first_frame + 1;
+  std::vector<int> sheet_frames;
+  // Fractions of the sequence that fall on different phases of a periodic motion.
+  for (double fraction : {0.1, 0.3, 0.55, 0.85}) {
+    sheet_frames.push_back(static_cast<int>(fraction * (count - 1)));
+  }
+  std::vector<std::array<cv::Mat, 3>> sheet_panels;
+  cv::Rect sheet_box;
+  for (int i = 0; i < count; ++i) {
+    const MotionFrame& m = motion.frames[options.first_frame + i];
+    const TriangleMesh posed = hand.Pose(m.cam_from_bone);
+    render::RenderItem hand_item{&posed, Rigid3(), options.hand_rgb, false, render::kHand};
+    render::RenderItem object_item{&object_mesh, m.cam_from_object, options.object_rgb, true,
+                                   render::kObject};
+    const render::RenderOutput rendering = renderer.Render({hand_item, object_item});
+    Frame frame = ApplySensorModel(rendering, options.intrinsics, options.sensor, rng);
+    frame.index = i;
+    frame.depth_timestamp_us = frame.color_timestamp_us =
+        static_cast<std::int64_t>(std::llround(i * 1e6 / options.fps));
+    if (oni) oni->Write(frame);
+    if (tum) tum->Write(frame);
+
+    const double t = frame.depth_timestamp_us * 1e-6;
+    trajectory.push_back({t, m.cam_from_object});
+    joints.push_back({i, hand.JointPositions(m.cam_from_bone)});
+    const HandObjectContact contact =
+        geometry.Measure(posed, object, m.cam_from_object, options.touch_mm);
+    std::string row = std::to_string(i) + "," + (m.held ? "1" : "0");
+    for (const auto& tip : contact.fingertips) row += tip.touching ? ",1" : ",0";
+    char number[32];
+    for (const auto& tip : contact.fingertips) {
+      std::snprintf(number, sizeof number, ",%.3f", std::min(tip.distance_mm, 999.0));
+      row += number;
+    }
+    std::snprintf(number, sizeof number, ",%.3f\n", contact.max_penetration_mm);
+    contacts_csv += row + number;
+    summary.held_frames += m.held ? 1 : 0;
+    summary.max_penetration_mm = std::max(summary.max_penetration_mm, contact.max_penetration_mm);
+
+    cv::Mat labels(rendering.height, rendering.width, CV_8UC1,
+                   const_cast<std::uint8_t*>(rendering.labels.data()));
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.png", i);
+    WritePng(gt / "labels" / name, labels);
+    if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
+      cv::Mat rgb(frame.height, frame.width, CV_8UC3, frame.rgb.data()), bgr;
+      cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+      sheet_panels.push_back(
+          {bgr, DepthImage(frame), LabelImage(rendering.labels, frame.width, frame.height)});
+      const cv::Rect box = cv::boundingRect(labels);
+      sheet_box = sheet_box.area() == 0 ? box : (sheet_box | box);
+    }
+  }
+  if (oni) oni->Close();
+  if (tum) tum->Finish();
+  summary.frames = count;
+  summary.recorded = recorded_report;
+
+  WriteTumTrajectory(gt / "trajectory.txt", trajectory,
+                     {"cam_from_object of " + object.name() + " (mm), one pose per frame"});
+  WriteMesh(gt / "object.ply", object_mesh);
+  tracker::WriteHandJointsCsv(gt / "hand_joints.csv", bone_names, joints);
+  WriteFileAtomically(gt / "contacts.csv", contacts_csv);
+  WriteFileAtomically(gt / "intrinsics.json", IntrinsicsJson(options.intrinsics).dump(2) + "\n");
+  // The contact sheet, cropped to where the hand and object are (with a margin and the label).
+  const int margin = 30;
+  sheet_box = cv::Rect(sheet_box.x - margin, sheet_box.y - margin, sheet_box.width + 2 * margin,
+                       sheet_box.height + 2 * margin);
+  sheet_box &= cv::Rect(0, 0, options.intrinsics.width, options.intrinsics.height);
+  std::vector<cv::Mat> rows;
+  for (size_t r = 0; r < sheet_panels.size(); ++r) {
+    const auto& panels = sheet_panels[r];
+    cv::putText(panels[0], "frame " + std::to_string(sheet_frames[r]),
+                {sheet_box.x + 5, sheet_box.y + 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
+                cv::Scalar(255, 255, 255), 1);
+    cv::Mat row;
+    cv::hconcat(
+        std::vector<cv::Mat>{panels[0](sheet_box), panels[1](sheet_box), panels[2](sheet_box)},
+        row);
+    rows.push_back(row);
+  }
+  cv::Mat sheet;
+  cv::vconcat(rows, sheet);
+  WritePng(out / "contact_sheet.png", sheet);
+
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const auto& s = options.sensor;
+  const auto& sc = options.scripted;
+  const auto& rc = options.recorded;
+  json manifest = {
+      {"generator", "inhandscan-synth " IHS_VERSION},
+      {"object",
+       {{"spec", options.object},
+        {"name", object.name()},
+        {"height_mm", object.height_mm()},
+        {"max_radius_mm", object.max_radius_mm()},
+        {"textured", object.textured()},
+        {"volume_mm3", object.mesh().Volume()}}},
+      {"motion", options.motion},
+      {"hand", options.hand},
+      {"hand_bones", bone_names.size()},
+      {"frames", {{"first", options.first_frame}, {"last", last}, {"count", count}}},
+      {"seed", options.seed},
+      {"fps", options.fps},
+      {"touch_mm", options.touch_mm},
+      {"hand_rgb", options.hand_rgb},
+      {"object_rgb", options.object_rgb},
+      {"intrinsics", IntrinsicsJson(options.intrinsics)},
+      {"sensor",
+       {{"depth_noise", s.depth_noise},
+        {"noise_coefficient_per_mm", s.noise_coefficient_per_mm},
+        {"quantization", s.quantization},
+        {"baseline_mm", s.baseline_mm},
+        {"subpixel", s.subpixel},
+        {"grazing_dropout", s.grazing_dropout},
+        {"max_incidence_deg", s.max_incidence_deg},
+        {"silhouette_effects", s.silhouette_effects},
+        {"edge_jump_mm", s.edge_jump_mm},
+        {"edge_dropout_probability", s.edge_dropout_probability},
+        {"flying_probability", s.flying_probability},
+        {"color_noise", s.color_noise},
+        {"color_sigma", s.color_sigma},
+        {"misregistration", s.misregistration},
+        {"max_misregistration_px", s.max_misregistration_px}}},
+      {"summary",
+       {{"frames", count},
+        {"held_frames", summary.held_frames},
+        {"max_penetration_mm", summary.max_penetration_mm},
+        {"seconds", summary.seconds}}},
+  };
+  if (recorded) {
+    const auto& r = recorded_report;
+    manifest["recorded"] = {{"contact_mm", rc.contact_mm},
+                            {"max_penetration_mm", rc.max_penetration_mm},
+                            {"prior_weight", rc.prior_weight},
+                            {"slip_mm", rc.slip_mm},
+                            {"report",
+                             {{"placed_frames", r.frames},
+                              {"grasp_frame", r.grasp_frame},
+                              {"held_frames", r.held_frames},
+                              {"carried_within_3mm_share", r.carried_within_3mm_share},
+                              {"placed_within_3mm_share", r.placed_within_3mm_share},
+                              {"penetration_p95_mm", r.penetration_p95_mm},
+                              {"penetration_max_mm", r.penetration_max_mm}}}};
+  } else {
+    manifest["scripted"] = {{"frames", sc.frames},
+                            {"turns", sc.turns},
+                            {"turn_per_grasp_deg", sc.turn_per_grasp_deg},
+                            {"distance_mm", sc.distance_mm},
+                            {"tilt_deg", sc.tilt_deg},
+                            {"sway_mm", sc.sway_mm},
+                            {"sway_deg", sc.sway_deg},
+                            {"press_mm", sc.press_mm},
+                            {"release_mm", sc.release_mm},
+                            {"slip_mm", sc.slip_mm},
+                            {"seed", sc.seed},
+                            {"grasp_height_mm", GraspHeight(object)}};
+  }
+  WriteFileAtomically(gt / "manifest.json", manifest.dump(2) + "\n");
+  return summary;
+}
+
+}  // namespace ihs::synth
