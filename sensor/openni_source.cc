@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <deque>
 #include <mutex>
+#include <thread>
 
 #include "core/check.h"
 #include "core/errors.h"
@@ -83,6 +85,7 @@ struct OpenNiSource::Impl : public openni::OpenNI::DeviceDisconnectedListener {
   bool is_file = false;
   bool runtime_acquired = false;
   bool listening = false;
+  bool depth_started = false;
   std::string uri;
   std::string description;
   CameraIntrinsics intrinsics;
@@ -110,10 +113,21 @@ struct OpenNiSource::Impl : public openni::OpenNI::DeviceDisconnectedListener {
       openni::OpenNI::removeDeviceDisconnectedListener(this);
       listening = false;
     }
+    // OpenNI2's file player (at our speed, manual mode) delivers a frame after each one read.
+    // Stopping a stream while the player thread delivers to it crashes; so does closing the
+    // device before that thread first ran (it then loops until OpenNI2 cancels it). Both were
+    // seen under load. A frame pending and unread means the thread runs and now waits for us:
+    // wait for one (unless the whole recording was read), then stop, then close.
+    if (is_file && depth_started &&
+        !(depth_frame_count >= 0 && depth_frames_read >= depth_frame_count)) {
+      openni::VideoStream* streams[] = {&depth};
+      int ready = -1;
+      if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, 2000) == openni::STATUS_OK) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    }
     if (depth.isValid()) depth.stop();
     if (color.isValid()) color.stop();
-    // OpenNI2's file player keeps a thread that can still hand a frame to a stream being
-    // destroyed; closing the device first ends that thread.
     if (device.isValid()) device.close();
     if (depth.isValid()) depth.destroy();
     if (color.isValid()) color.destroy();
@@ -210,6 +224,7 @@ void OpenNiSource::Start() {
   if (impl->depth.start() != openni::STATUS_OK) {
     throw DeviceError(impl->description + ": cannot start the depth stream: " + ExtendedError());
   }
+  impl->depth_started = true;
   if (impl->has_color && impl->color.start() != openni::STATUS_OK) {
     spdlog::warn("{}: cannot start the colour stream ({}); continuing with depth only",
                  impl->description, ExtendedError());
