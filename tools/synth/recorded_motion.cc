@@ -18,6 +18,10 @@ namespace {
 using tracker::HandModel;
 
 constexpr double kReportDistanceMm = 3.0;
+// Frames ahead over which the fingertips' turn at the grasp is measured, and the least turn that
+// counts.
+constexpr int kTurnFrames = 60;
+constexpr double kMinTurnRad = 10 * M_PI / 180;
 
 class Placer {
  public:
@@ -125,7 +129,23 @@ class Placer {
   }
 
   // The object placed between thumb and index, or nothing when this frame admits no grasp.
-  bool PlaceAtGrasp(const TriangleMesh& posed, Rigid3* cam_from_object) const {
+  // Mean of a fingertip's skin vertices.
+  Eigen::Vector3d TipCentre(const TriangleMesh& posed, int tip) const {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int v : geometry_.fingertip_vertices()[tip]) sum += posed.vertices[v].cast<double>();
+    return sum / static_cast<double>(geometry_.fingertip_vertices()[tip].size());
+  }
+
+  // The axis (camera frame) about which the thumb and index turn from `posed` to `later`, or
+  // zero when they hardly turn.
+  Eigen::Vector3d TurnAxis(const TriangleMesh& posed, const TriangleMesh& later) const {
+    const Rigid3 motion = CarriedMotion(posed, later, {thumb_, index_});
+    if (motion.RotationAngleRad() < kMinTurnRad) return Eigen::Vector3d::Zero();
+    return motion.RotationVector().normalized();
+  }
+
+  bool PlaceAtGrasp(const TriangleMesh& posed, const Eigen::Vector3d& turn_axis,
+                    Rigid3* cam_from_object) const {
     // The closest pair of thumb and index skin points: the gap the object fills.
     double gap = std::numeric_limits<double>::infinity();
     Eigen::Vector3d thumb_point = Eigen::Vector3d::Zero(), index_point = Eigen::Vector3d::Zero();
@@ -155,10 +175,20 @@ class Placer {
     a0.normalize();
     double best_score = std::numeric_limits<double>::infinity();
     Rigid3 best;
-    for (double z : heights) {
+    // The object's axis lies across the gap. When the fingertips turn it, they turn it about its
+    // axis: take the turn axis's part across the gap (either way up); else try 24 directions.
+    std::vector<Eigen::Vector3d> axes;
+    const Eigen::Vector3d across = turn_axis - turn_axis.dot(u) * u;
+    if (across.norm() > 0.5) {
+      axes = {across.normalized(), -across.normalized()};
+    } else {
       for (int k = 0; k < 24; ++k) {
         const double psi = 2 * M_PI * k / 24;
-        const Eigen::Vector3d axis = std::cos(psi) * a0 + std::sin(psi) * u.cross(a0);
+        axes.push_back(std::cos(psi) * a0 + std::sin(psi) * u.cross(a0));
+      }
+    }
+    for (double z : heights) {
+      for (const Eigen::Vector3d& axis : axes) {
         Eigen::Matrix3d rotation;
         rotation.col(0) = u;
         rotation.col(1) = axis.cross(u);
@@ -214,7 +244,10 @@ Motion MakeRecordedMotion(const tracker::RecordedHand& recorded, const ObjectSha
   std::vector<Rigid3> cam_from_object(frames);
   int grasp = -1;
   for (int t = 0; t < frames && grasp < 0; ++t) {
-    if (placer.PlaceAtGrasp(posed(t), &cam_from_object[t])) grasp = t;
+    const TriangleMesh now = posed(t);
+    const Eigen::Vector3d turn_axis =
+        placer.TurnAxis(now, posed(std::min(t + kTurnFrames, session_frames - 1)));
+    if (placer.PlaceAtGrasp(now, turn_axis, &cam_from_object[t])) grasp = t;
   }
   if (grasp < 0) {
     throw InputError("the recorded motion never holds '" + object.name() +
@@ -239,7 +272,14 @@ Motion MakeRecordedMotion(const tracker::RecordedHand& recorded, const ObjectSha
       const TriangleMesh current = posed(t);
       const Rigid3& before = cam_from_object[t - direction];
       const std::vector<int> holding = placer.Holding(previous, before);
+      // Not pinched: it keeps its orientation (supported while fingers re-grasp) and moves with a
+      // single fingertip still touching it; with none it stays where it is.
       Rigid3 predicted = before;
+      if (holding.size() == 1) {
+        predicted = Rigid3::Translation(placer.TipCentre(current, holding[0]) -
+                                        placer.TipCentre(previous, holding[0])) *
+                    before;
+      }
       if (holding.size() >= 2) {
         predicted = placer.CarriedMotion(previous, current, holding) * before;
         const Rigid3 object_from_cam = predicted.Inverse();

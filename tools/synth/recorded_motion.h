@@ -3,15 +3,19 @@
 // object placed in the hand. The sessions recorded the hand only, so the object's pose is
 // derived from the fingertips that touch it, by this rule:
 //
-//  1. Grasp: the first frame at which the object can be put between the thumb and index
-//     fingertips — their skin gap equals the object's diameter at some height, the axis across
-//     the gap (24 turns about the gap line tried) — with both fingertips within `contact_mm` of
-//     the surface and the hand's skin at most `max_penetration_mm` inside the object.
+//  1. Grasp: the first frame at which the object fits between the thumb and index fingertips:
+//     their skin gap equals the object's diameter at some height, its axis lies across the gap,
+//     turned about the gap line to the axis the two fingertips turn about over the next 60
+//     frames (when they turn by 10° or more; otherwise the best of 24 directions), either way
+//     up — with both fingertips within `contact_mm` of the surface and the hand's skin at most
+//     `max_penetration_mm` inside the object.
 //  2. Forward from there: the fingertips holding the object in the previous frame (within
 //     `contact_mm`, at least two) carry it: it moves with their rigid motion (least squares over
-//     their skin vertices). With fewer than two holding fingertips it stays where it is.
-//     Each frame's pose is then corrected (Levenberg–Marquardt, weakly tied to the carried pose)
-//     so that the holding fingertips lie on the surface and no skin is inside the object.
+//     their skin vertices). With one fingertip left on it (the others re-grasping) it keeps its
+//     orientation and moves with that fingertip; with none it stays where it is.
+//     Each frame's pose is then corrected (Levenberg–Marquardt, tied to the carried pose by
+//     `prior_weight`) so that the fingertips within `contact_mm` lie on the surface and no skin
+//     is inside the object.
 //  3. Backward from the grasp frame to the first frame, the same with time reversed.
 //
 // The report says how well this holds: in how many held frames the holding fingertips are
@@ -32,8 +36,9 @@ struct RecordedMotionOptions {
   double contact_mm = 3.0;
   /// Largest penetration accepted for the initial grasp, mm.
   double max_penetration_mm = 3.0;
-  /// Weight of the carried pose in the per-frame correction (per mm; per rad × 50 mm).
-  double prior_weight = 0.05;
+  /// Weight of the carried pose in the per-frame correction (per mm; per rad × 50 mm): high
+  /// enough that fingers opening to re-grasp let go of the object rather than slide it.
+  double prior_weight = 3.0;
   /// Slip: while held, the object turns about its own axis relative to the fingers by a random
   /// walk of this many mm per frame at the contact radius (0 = none).
   double slip_mm = 0.0;
