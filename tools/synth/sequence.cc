@@ -102,40 +102,76 @@ void SequenceOptions::Check() const {
   recorded.Check();
 }
 
-SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path& out) {
-  options.Check();
-  const auto started = std::chrono::steady_clock::now();
-  const ObjectShape object = ObjectShape::FromSpec(options.object);
-
-  // The hand and its motion.
-  tracker::HandModel hand;
-  Motion motion;
-  RecordedMotionReport recorded_report;
-  const bool recorded = options.motion != "scripted";
+SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
+    : options_(options), object_(ObjectShape::FromSpec((options.Check(), options.object))) {
+  const bool recorded = options_.motion != "scripted";
   if (recorded) {
-    const fs::path session = options.motion.substr(9);
-    const fs::path data_dir =
-        options.hand == "procedural" ? session.parent_path().parent_path() : fs::path(options.hand);
+    const fs::path session = options_.motion.substr(9);
+    const fs::path data_dir = options_.hand == "procedural" ? session.parent_path().parent_path()
+                                                            : fs::path(options_.hand);
     tracker::RecordedHand recording = tracker::LoadRecordedHand(data_dir, session);
-    RecordedMotionOptions recorded_options = options.recorded;
-    recorded_options.last_frame = options.last_frame;
-    motion = MakeRecordedMotion(recording, object, recorded_options, &recorded_report);
-    hand = std::move(recording.model);
+    RecordedMotionOptions recorded_options = options_.recorded;
+    recorded_options.last_frame = options_.last_frame;
+    motion_ = MakeRecordedMotion(recording, object_, recorded_options, &recorded_report_);
+    hand_ = std::move(recording.model);
   } else {
-    if (options.hand == "procedural") {
-      hand = tracker::MakeProceduralHand();
+    if (options_.hand == "procedural") {
+      hand_ = tracker::MakeProceduralHand();
     } else {
-      hand = tracker::LoadRecordedHand(options.hand, FirstSession(options.hand)).model;
+      hand_ = tracker::LoadRecordedHand(options_.hand, FirstSession(options_.hand)).model;
     }
-    motion = MakeScriptedMotion(hand, object, options.scripted);
+    motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }
-  const int available = static_cast<int>(motion.frames.size());
-  const int last = options.last_frame < 0 ? available - 1 : options.last_frame;
-  if (options.first_frame >= available || last >= available) {
-    throw std::invalid_argument("frames " + std::to_string(options.first_frame) + ":" +
-                                std::to_string(last) +
+  const int available = static_cast<int>(motion_.frames.size());
+  last_ = options_.last_frame < 0 ? available - 1 : options_.last_frame;
+  if (options_.first_frame >= available || last_ >= available) {
+    throw std::invalid_argument("frames " + std::to_string(options_.first_frame) + ":" +
+                                std::to_string(last_) +
                                 " outside the motion's 0:" + std::to_string(available - 1));
   }
+  object_mesh_ = object_.mesh();
+  if (!object_.textured())
+    object_mesh_.colors.assign(object_mesh_.vertices.size(), options_.object_rgb);
+  geometry_ = std::make_unique<HandObjectGeometry>(hand_);
+  renderer_ = std::make_unique<render::OffscreenRenderer>(options_.intrinsics);
+}
+
+SequenceRenderer::~SequenceRenderer() = default;
+
+RenderedFrame SequenceRenderer::Render(int i) {
+  IHS_CHECK_ARG(i >= 0 && i < frame_count(), "frame " << i << " outside 0:" << frame_count() - 1);
+  const MotionFrame& m = motion_.frames[options_.first_frame + i];
+  RenderedFrame out;
+  out.posed_hand = hand_.Pose(m.cam_from_bone);
+  const render::RenderItem hand_item{&out.posed_hand, Rigid3(), options_.hand_rgb, false,
+                                     render::kHand};
+  const render::RenderItem object_item{&object_mesh_, m.cam_from_object, options_.object_rgb, true,
+                                       render::kObject};
+  render::RenderOutput rendering = renderer_->Render({hand_item, object_item});
+  std::seed_seq seeds{options_.seed, static_cast<std::uint32_t>(i)};
+  std::mt19937 rng(seeds);
+  out.frame = ApplySensorModel(rendering, options_.intrinsics, options_.sensor, rng);
+  out.frame.index = i;
+  out.frame.depth_timestamp_us = out.frame.color_timestamp_us =
+      static_cast<std::int64_t>(std::llround(i * 1e6 / options_.fps));
+  out.labels = std::move(rendering.labels);
+  out.cam_from_object = m.cam_from_object;
+  out.cam_from_bone = m.cam_from_bone;
+  out.joints_mm = hand_.JointPositions(m.cam_from_bone);
+  out.contact = geometry_->Measure(out.posed_hand, object_, m.cam_from_object, options_.touch_mm);
+  out.held = m.held;
+  return out;
+}
+
+SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path& out) {
+  const auto started = std::chrono::steady_clock::now();
+  SequenceRenderer renderer(options);
+  const ObjectShape& object = renderer.object();
+  const tracker::HandModel& hand = renderer.hand();
+  const HandObjectGeometry& geometry = renderer.geometry();
+  const RecordedMotionReport& recorded_report = renderer.recorded_report();
+  const bool recorded = options.motion != "scripted";
+  const int last = options.first_frame + renderer.frame_count() - 1;
 
   // Outputs.
   const fs::path gt = out / "gt";
@@ -151,13 +187,6 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
   }
   std::unique_ptr<sensor::TumWriter> tum;
   if (options.write_tum) tum = std::make_unique<sensor::TumWriter>(out / "tum", options.intrinsics);
-
-  TriangleMesh object_mesh = object.mesh();
-  if (!object.textured())
-    object_mesh.colors.assign(object_mesh.vertices.size(), options.object_rgb);
-  render::OffscreenRenderer renderer(options.intrinsics);
-  const HandObjectGeometry geometry(hand);
-  std::mt19937 rng(options.seed);
 
   std::vector<std::string> bone_names;
   for (const auto& bone : hand.bones) bone_names.push_back(bone.name);
@@ -180,25 +209,16 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
   std::vector<std::array<cv::Mat, 3>> sheet_panels;
   cv::Rect sheet_box;
   for (int i = 0; i < count; ++i) {
-    const MotionFrame& m = motion.frames[options.first_frame + i];
-    const TriangleMesh posed = hand.Pose(m.cam_from_bone);
-    render::RenderItem hand_item{&posed, Rigid3(), options.hand_rgb, false, render::kHand};
-    render::RenderItem object_item{&object_mesh, m.cam_from_object, options.object_rgb, true,
-                                   render::kObject};
-    const render::RenderOutput rendering = renderer.Render({hand_item, object_item});
-    Frame frame = ApplySensorModel(rendering, options.intrinsics, options.sensor, rng);
-    frame.index = i;
-    frame.depth_timestamp_us = frame.color_timestamp_us =
-        static_cast<std::int64_t>(std::llround(i * 1e6 / options.fps));
+    const RenderedFrame rendered = renderer.Render(i);
+    const Frame& frame = rendered.frame;
     if (oni) oni->Write(frame);
     if (tum) tum->Write(frame);
 
     const double t = frame.depth_timestamp_us * 1e-6;
-    trajectory.push_back({t, m.cam_from_object});
-    joints.push_back({i, hand.JointPositions(m.cam_from_bone)});
-    const HandObjectContact contact =
-        geometry.Measure(posed, object, m.cam_from_object, options.touch_mm);
-    std::string row = std::to_string(i) + "," + (m.held ? "1" : "0");
+    trajectory.push_back({t, rendered.cam_from_object});
+    joints.push_back({i, rendered.joints_mm});
+    const HandObjectContact& contact = rendered.contact;
+    std::string row = std::to_string(i) + "," + (rendered.held ? "1" : "0");
     for (const auto& tip : contact.fingertips) row += tip.touching ? ",1" : ",0";
     char number[32];
     for (const auto& tip : contact.fingertips) {
@@ -207,19 +227,20 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
     }
     std::snprintf(number, sizeof number, ",%.3f\n", contact.max_penetration_mm);
     contacts_csv += row + number;
-    summary.held_frames += m.held ? 1 : 0;
+    summary.held_frames += rendered.held ? 1 : 0;
     summary.max_penetration_mm = std::max(summary.max_penetration_mm, contact.max_penetration_mm);
 
-    cv::Mat labels(rendering.height, rendering.width, CV_8UC1,
-                   const_cast<std::uint8_t*>(rendering.labels.data()));
+    cv::Mat labels(frame.height, frame.width, CV_8UC1,
+                   const_cast<std::uint8_t*>(rendered.labels.data()));
     char name[32];
     std::snprintf(name, sizeof name, "%06d.png", i);
     WritePng(gt / "labels" / name, labels);
     if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
-      cv::Mat rgb(frame.height, frame.width, CV_8UC3, frame.rgb.data()), bgr;
+      cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+      cv::Mat bgr;
       cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
       sheet_panels.push_back(
-          {bgr, DepthImage(frame), LabelImage(rendering.labels, frame.width, frame.height)});
+          {bgr, DepthImage(frame), LabelImage(rendered.labels, frame.width, frame.height)});
       const cv::Rect box = cv::boundingRect(labels);
       sheet_box = sheet_box.area() == 0 ? box : (sheet_box | box);
     }
@@ -231,7 +252,7 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
 
   WriteTumTrajectory(gt / "trajectory.txt", trajectory,
                      {"cam_from_object of " + object.name() + " (mm), one pose per frame"});
-  WriteMesh(gt / "object.ply", object_mesh);
+  WriteMesh(gt / "object.ply", renderer.object_mesh());
   tracker::WriteHandJointsCsv(gt / "hand_joints.csv", bone_names, joints);
   WriteFileAtomically(gt / "contacts.csv", contacts_csv);
   WriteFileAtomically(gt / "intrinsics.json", IntrinsicsJson(options.intrinsics).dump(2) + "\n");

@@ -17,9 +17,15 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "render/offscreen_renderer.h"
+#include "tools/synth/hand_object.h"
+#include "tools/synth/motion.h"
 #include "tools/synth/recorded_motion.h"
 #include "tools/synth/scripted_motion.h"
 #include "tools/synth/sensor_model.h"
@@ -71,6 +77,59 @@ struct SequenceSummary {
   /// Recorded motion only: the placement report (see RecordedMotionReport).
   RecordedMotionReport recorded;
   double seconds = 0;
+};
+
+/// One rendered frame with its ground truth.
+struct RenderedFrame {
+  /// What the sensor delivers: depth (mm) and colour, index and timestamps set.
+  Frame frame;
+  /// Per-pixel labels of the noise-free rendering (render::Label).
+  std::vector<std::uint8_t> labels;
+  Rigid3 cam_from_object;
+  /// The hand: every bone's transform, the 21 joints (camera frame, mm), the skinned mesh.
+  std::vector<Rigid3> cam_from_bone;
+  std::vector<Eigen::Vector3d> joints_mm;
+  TriangleMesh posed_hand;
+  /// Fingertips against the object (touch threshold: options.touch_mm).
+  HandObjectContact contact;
+  /// Whether the object moves with the hand in this frame.
+  bool held = false;
+};
+
+/// Builds the hand, the object and the motion of a sequence and renders its frames one at a
+/// time, in memory (GenerateSequence writes what it renders). Frame i's noise depends only on
+/// the seed and i, so any frame can be rendered on its own.
+class SequenceRenderer {
+ public:
+  /// Throws like GenerateSequence.
+  explicit SequenceRenderer(const SequenceOptions& options);
+  ~SequenceRenderer();
+  SequenceRenderer(const SequenceRenderer&) = delete;
+  SequenceRenderer& operator=(const SequenceRenderer&) = delete;
+
+  /// Frames in the chosen range.
+  int frame_count() const { return last_ - options_.first_frame + 1; }
+  /// Renders frame i of the range (0-based; frame.index = i).
+  RenderedFrame Render(int i);
+
+  const SequenceOptions& options() const { return options_; }
+  const tracker::HandModel& hand() const { return hand_; }
+  const ObjectShape& object() const { return object_; }
+  /// The object's mesh as rendered (with its colours).
+  const TriangleMesh& object_mesh() const { return object_mesh_; }
+  const HandObjectGeometry& geometry() const { return *geometry_; }
+  const RecordedMotionReport& recorded_report() const { return recorded_report_; }
+
+ private:
+  const SequenceOptions options_;
+  ObjectShape object_;
+  TriangleMesh object_mesh_;
+  tracker::HandModel hand_;
+  Motion motion_;
+  RecordedMotionReport recorded_report_;
+  int last_ = 0;
+  std::unique_ptr<HandObjectGeometry> geometry_;
+  std::unique_ptr<render::OffscreenRenderer> renderer_;
 };
 
 /// Generates the sequence into `out` (created if needed). Throws std::invalid_argument for bad

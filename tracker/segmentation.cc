@@ -1,0 +1,160 @@
+#include "tracker/segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "core/check.h"
+#include "tracker/skin_model.h"
+
+namespace ihs::tracker {
+namespace {
+
+enum Class : std::uint8_t { kNone = 0, kSkin = 1, kOther = 2 };
+
+// Labels 4-connected regions of equal class whose neighbouring depths differ by at most
+// `max_step_mm`; returns the region of each pixel (−1 for kNone) and fills `sizes`.
+std::vector<int> Regions(const std::vector<std::uint8_t>& classes,
+                         const std::vector<std::uint16_t>& depth, int width, int height,
+                         double max_step_mm, std::vector<int>* sizes) {
+  std::vector<int> region(classes.size(), -1);
+  std::vector<int> stack;
+  sizes->clear();
+  for (size_t start = 0; start < classes.size(); ++start) {
+    if (classes[start] == kNone || region[start] >= 0) continue;
+    const int id = static_cast<int>(sizes->size());
+    int size = 0;
+    region[start] = id;
+    stack.push_back(static_cast<int>(start));
+    while (!stack.empty()) {
+      const int p = stack.back();
+      stack.pop_back();
+      ++size;
+      const int u = p % width, v = p / width;
+      const int neighbours[4] = {u > 0 ? p - 1 : -1, u + 1 < width ? p + 1 : -1,
+                                 v > 0 ? p - width : -1, v + 1 < height ? p + width : -1};
+      for (int q : neighbours) {
+        if (q < 0 || region[q] >= 0 || classes[q] != classes[p]) continue;
+        if (std::abs(static_cast<int>(depth[q]) - static_cast<int>(depth[p])) > max_step_mm)
+          continue;
+        region[q] = id;
+        stack.push_back(q);
+      }
+    }
+    sizes->push_back(size);
+  }
+  return region;
+}
+
+}  // namespace
+
+void SegmentationOptions::Check() const {
+  IHS_CHECK_ARG((crop_min_mm.array() < crop_max_mm.array()).all(),
+                "segmentation.crop_min_mm must be below crop_max_mm on every axis");
+  IHS_CHECK_ARG(crop_min_mm.z() > 0, "segmentation.crop_min_mm.z must be positive");
+  IHS_CHECK_ARG(connect_depth_mm > 0, "segmentation.connect_depth_mm must be positive");
+  IHS_CHECK_ARG(min_region_pixels >= 0, "segmentation.min_region_pixels must be >= 0");
+  IHS_CHECK_ARG(boundary_px >= 0 && boundary_px <= 20,
+                "segmentation.boundary_px must be in [0, 20]");
+  IHS_CHECK_ARG(max_object_distance_mm > 0, "segmentation.max_object_distance_mm must be positive");
+}
+
+Segmenter::Segmenter(const CameraIntrinsics& intrinsics, SegmentationOptions options)
+    : intrinsics_(intrinsics),
+      options_(std::move(options)),
+      skin_(std::make_unique<SkinColorModel>()) {
+  intrinsics_.Check();
+  options_.Check();
+}
+
+Segmenter::~Segmenter() = default;
+
+Segmentation Segmenter::Segment(const Frame& frame) const {
+  frame.Check();
+  IHS_CHECK_ARG(frame.width == intrinsics_.width && frame.height == intrinsics_.height,
+                "frame is " << frame.width << "x" << frame.height << ", the camera "
+                            << intrinsics_.width << "x" << intrinsics_.height);
+  const int w = frame.width, h = frame.height;
+  const size_t n = static_cast<size_t>(w) * h;
+  Segmentation out;
+  out.width = w;
+  out.height = h;
+  out.hand_mask.assign(n, 0);
+  out.object_mask.assign(n, 0);
+
+  // Classify cropped pixels by colour.
+  std::vector<std::uint8_t> classes(n, kNone);
+  std::vector<Eigen::Vector3f> points(n);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t p = static_cast<size_t>(v) * w + u;
+      const std::uint16_t z = frame.depth_mm[p];
+      if (z == 0) continue;
+      const Eigen::Vector3d x = intrinsics_.BackProject(u, v, z);
+      if ((x.array() < options_.crop_min_mm.array()).any() ||
+          (x.array() > options_.crop_max_mm.array()).any()) {
+        continue;
+      }
+      ++out.cropped_pixels;
+      points[p] = x.cast<float>();
+      bool skin = false;
+      if (frame.HasColor()) {
+        const std::uint8_t* c = &frame.rgb[3 * p];
+        skin = skin_->LogLikelihoodRatio(c[0], c[1], c[2]) > options_.skin_log_ratio;
+      }
+      classes[p] = skin ? kSkin : kOther;
+    }
+  }
+
+  // Depth-connected regions; small ones go.
+  std::vector<int> sizes;
+  const std::vector<int> region =
+      Regions(classes, frame.depth_mm, w, h, options_.connect_depth_mm, &sizes);
+  Eigen::Vector3d hand_sum = Eigen::Vector3d::Zero();
+  int hand_count = 0;
+  for (size_t p = 0; p < n; ++p) {
+    if (classes[p] != kSkin || sizes[region[p]] < options_.min_region_pixels) continue;
+    out.hand_mask[p] = 1;
+    hand_sum += points[p].cast<double>();
+    ++hand_count;
+  }
+
+  // Object regions: not skin, not touching the hand's boundary band, near the hand.
+  std::vector<std::uint8_t> near_hand(n, 0);
+  const int r = options_.boundary_px;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      if (!out.hand_mask[static_cast<size_t>(v) * w + u]) continue;
+      for (int dv = -r; dv <= r; ++dv) {
+        for (int du = -r; du <= r; ++du) {
+          const int uu = u + du, vv = v + dv;
+          if (uu >= 0 && uu < w && vv >= 0 && vv < h)
+            near_hand[static_cast<size_t>(vv) * w + uu] = 1;
+        }
+      }
+    }
+  }
+  std::vector<Eigen::Vector3d> region_sum(sizes.size(), Eigen::Vector3d::Zero());
+  for (size_t p = 0; p < n; ++p) {
+    if (classes[p] == kOther) region_sum[region[p]] += points[p].cast<double>();
+  }
+  const Eigen::Vector3d hand_centre =
+      hand_count > 0 ? Eigen::Vector3d(hand_sum / hand_count) : Eigen::Vector3d::Zero();
+  for (size_t p = 0; p < n; ++p) {
+    if (classes[p] != kOther || near_hand[p]) continue;
+    const int id = region[p];
+    if (sizes[id] < options_.min_region_pixels) continue;
+    if (hand_count > 0 &&
+        (region_sum[id] / sizes[id] - hand_centre).norm() > options_.max_object_distance_mm) {
+      continue;
+    }
+    out.object_mask[p] = 1;
+  }
+  for (size_t p = 0; p < n; ++p) {
+    if (out.hand_mask[p]) out.hand_points.push_back(points[p]);
+    if (out.object_mask[p]) out.object_points.push_back(points[p]);
+  }
+  return out;
+}
+
+}  // namespace ihs::tracker

@@ -1,0 +1,72 @@
+#pragma once
+// Preprocessing of the paper: keep the points inside a crop volume, split them into hand and
+// object by skin colour (Jones & Rehg mixtures, likelihood ratio), and clean both masks with the
+// depth: regions are connected only across small depth steps, small regions are dropped, and
+// object pixels next to the hand (mixed colour and depth at the boundary) are left out.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+
+namespace ihs::tracker {
+
+class SkinColorModel;
+
+/// Options of the segmentation (defaults: the paper's crop volume).
+struct SegmentationOptions {
+  /// Crop volume in the camera frame, mm (paper: x ∈ [−100, 100], y ∈ [−140, 220], z ∈ [400,
+  /// 1000]).
+  Eigen::Vector3d crop_min_mm{-100, -140, 400};
+  Eigen::Vector3d crop_max_mm{100, 220, 1000};
+  /// A pixel is skin when log p(rgb | skin) − log p(rgb | non-skin) exceeds this.
+  double skin_log_ratio = 0.0;
+  /// Neighbouring pixels belong to one region only when their depths differ by at most this, mm.
+  double connect_depth_mm = 15.0;
+  /// Regions smaller than this many pixels are dropped (speckle, stray colour).
+  int min_region_pixels = 120;
+  /// Object pixels within this many pixels of the hand are left out (mixed boundary pixels).
+  int boundary_px = 2;
+  /// Object regions whose centre is farther than this from the hand's centre are left out, mm.
+  double max_object_distance_mm = 250.0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Hand and object pixels of one frame.
+struct Segmentation {
+  int width = 0;
+  int height = 0;
+  /// Per pixel, row-major: 1 where the hand / the object is, else 0.
+  std::vector<std::uint8_t> hand_mask;
+  std::vector<std::uint8_t> object_mask;
+  /// The masked pixels back-projected (camera frame, mm), in pixel order.
+  std::vector<Eigen::Vector3f> hand_points;
+  std::vector<Eigen::Vector3f> object_points;
+  /// Pixels with depth inside the crop volume.
+  int cropped_pixels = 0;
+};
+
+/// Splits frames into hand and object. Keeps the colour tables; one per thread.
+class Segmenter {
+ public:
+  explicit Segmenter(const CameraIntrinsics& intrinsics, SegmentationOptions options = {});
+  ~Segmenter();
+
+  /// Segments `frame` (depth in mm; colour registered to depth). A frame without colour has no
+  /// hand: every cropped region counts as object.
+  Segmentation Segment(const Frame& frame) const;
+
+  const SegmentationOptions& options() const { return options_; }
+
+ private:
+  const CameraIntrinsics intrinsics_;
+  const SegmentationOptions options_;
+  std::unique_ptr<SkinColorModel> skin_;
+};
+
+}  // namespace ihs::tracker
