@@ -1,0 +1,206 @@
+// Hand pose fitting: analytic derivatives against numeric ones, and fits to rendered hands.
+
+#include "tracker/hand_fit.h"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "render/offscreen_renderer.h"
+#include "tests/test_util.h"
+#include "tools/synth/sequence.h"
+#include "tracker/hand_data.h"
+#include "tracker/hand_fit_cost.h"
+#include "tracker/hand_kinematics.h"
+#include "tracker/procedural_hand.h"
+#include "tracker/segmentation.h"
+
+namespace ihs::tracker {
+namespace {
+
+HandPose RandomPose(const HandModel& model, std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1, 1);
+  HandPose pose = HandPose::Rest(
+      model, Rigid3::FromRotationVector(Eigen::Vector3d(unit(rng), unit(rng), unit(rng)),
+                                        Eigen::Vector3d(unit(rng) * 50, unit(rng) * 50, 600)));
+  const auto dofs = JointDegreesOfFreedom(model);
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    const auto [lo, hi] = model.limits[dofs[k].bone].limits_deg[dofs[k].axis];
+    // Within the limits mostly, a few beyond them (soft limits).
+    pose.angles_rad[k] = (0.5 * (lo + hi) + 0.6 * unit(rng) * (hi - lo)) * M_PI / 180;
+  }
+  return pose;
+}
+
+void CheckGradients(const HandModel& model, std::mt19937& rng) {
+  const HandPose pose = RandomPose(model, rng);
+  PoseParameters parameters(pose);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  // Perturb ω away from zero so the root's left Jacobian is exercised too.
+  for (int i = 0; i < 3; ++i) parameters.values()[i] = 0.3 * unit(rng);
+  std::vector<PointPair> pairs;
+  std::uniform_int_distribution<int> vertex(0,
+                                            static_cast<int>(model.rest_mesh.vertices.size()) - 1);
+  for (int i = 0; i < 40; ++i) {
+    pairs.push_back({vertex(rng),
+                     Eigen::Vector3d(unit(rng) * 80, unit(rng) * 80, 600 + unit(rng) * 50),
+                     0.5 + 0.5 * std::abs(unit(rng))});
+  }
+  std::vector<PlanePair> planes;
+  for (int i = 0; i < 30; ++i) {
+    planes.push_back({vertex(rng), Eigen::Vector3d(unit(rng) * 80, unit(rng) * 80, 600),
+                      Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized(), 0.7});
+  }
+  // Index and middle distal phalanges forced to overlap (radii larger than their distance).
+  const int index = model.BoneIndex("RFing.3_2"), middle = model.BoneIndex("RFing.2_2");
+  ASSERT_GE(index, 0);
+  ASSERT_GE(middle, 0);
+  std::vector<CollisionPair> collisions = {
+      {index, Eigen::Vector3d(5, 0, 0), 200, middle, Eigen::Vector3d(8, 0, 0), 200}};
+  std::vector<double> prior(pose.angles_rad.size());
+  for (double& a : prior) a = 0.2 * unit(rng);
+  HandFitCost cost(model, parameters.reference_rotation(), pairs, planes, collisions, 10.0, 30.0,
+                   1.5, prior);
+  // Ridders' first step small enough not to straddle the kinks of the soft limits.
+  ceres::NumericDiffOptions numeric;
+  numeric.ridders_relative_initial_step_size = 1e-4;
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::GradientChecker checker(&cost, no_manifolds, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  const double* blocks[] = {parameters.values().data()};
+  checker.Probe(blocks, 1e-5, &results);
+  // Entries that are zero analytically (e.g. a collision under a rigid motion of the whole hand)
+  // come out as round-off numerically: compare with an absolute floor.
+  const Eigen::MatrixXd& analytic = results.jacobians[0];
+  const Eigen::MatrixXd& numeric_jacobian = results.numeric_jacobians[0];
+  int bad = 0;
+  for (int r = 0; r < analytic.rows(); ++r) {
+    for (int c = 0; c < analytic.cols(); ++c) {
+      const double a = analytic(r, c), d = numeric_jacobian(r, c);
+      if (std::abs(a - d) > 1e-5 * std::max({1.0, std::abs(a), std::abs(d)})) {
+        ADD_FAILURE() << "row " << r << " col " << c << ": analytic " << a << ", numeric " << d;
+        ++bad;
+      }
+    }
+  }
+  EXPECT_EQ(bad, 0);
+}
+
+TEST(HandFitCostTest, AnalyticDerivativesMatchNumericOnesOnTheProceduralHand) {
+  std::mt19937 rng = test::Rng();
+  const HandModel procedural = MakeProceduralHand();
+  for (int i = 0; i < 3; ++i) CheckGradients(procedural, rng);
+}
+
+TEST(HandFitCostTest, AnalyticDerivativesMatchNumericOnesOnTheRealHand) {
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
+  std::mt19937 rng = test::Rng(1);
+  const RecordedHand real = LoadRecordedHand(data, data / "sequences" / "004-sphere");
+  for (int i = 0; i < 2; ++i) CheckGradients(real.model, rng);
+}
+
+double MeanJointError(const HandModel& model, const HandPose& pose,
+                      const std::vector<Eigen::Vector3d>& truth) {
+  const auto joints = model.JointPositions(ForwardKinematics(model, pose));
+  double sum = 0;
+  for (size_t j = 0; j < joints.size(); ++j) sum += (joints[j] - truth[j]).norm();
+  return sum / joints.size();
+}
+
+// A start far from the truth: about five frames of fast motion.
+constexpr double kRootRad = 0.08, kRootMm = 8, kAngleRad = 0.12;
+
+TEST(HandFitterTest, RecoversAPerturbedPoseOfARenderedHand) {
+  synth::SequenceOptions options;
+  options.object = "sphere";
+  options.scripted.frames = 60;
+  synth::SequenceRenderer renderer(options);
+  const HandModel& model = renderer.hand();
+  const Segmenter segmenter(options.intrinsics);
+  const HandFitter fitter(model, options.intrinsics);
+  std::mt19937 rng = test::Rng();
+  std::uniform_real_distribution<double> unit(-1, 1);
+  double before = 0, after = 0;
+  const int frames[] = {5, 20, 45};
+  for (int i : frames) {
+    const synth::RenderedFrame rendered = renderer.Render(i);
+    const HandPose truth = PoseFromBoneTransforms(model, rendered.cam_from_bone);
+    HandPose start = truth;
+    start.cam_from_root =
+        Rigid3::FromRotationVector(Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * kRootRad,
+                                   Eigen::Vector3d(unit(rng), unit(rng), unit(rng)) * kRootMm) *
+        truth.cam_from_root;
+    for (double& a : start.angles_rad) a += kAngleRad * unit(rng);
+    const Segmentation segmentation = segmenter.Segment(rendered.frame);
+    const HandFitResult fit = fitter.Fit(segmentation.hand_points, &rendered.frame, start);
+    const double e0 = MeanJointError(model, start, rendered.joints_mm);
+    const double e1 = MeanJointError(model, fit.pose, rendered.joints_mm);
+    std::printf("frame %d: joint error %.2f -> %.2f mm, data error %.2f mm, coverage %.2f / %.2f\n",
+                i, e0, e1, fit.data_error_mm, fit.data_coverage, fit.model_coverage);
+    before += e0 / 3, after += e1 / 3;
+  }
+  // Measured: 33.7 → 20.5 mm. One fit from this far does not get back to the truth (the
+  // hand behind the object is mostly hidden); tracking starts from the previous frame instead.
+  EXPECT_LT(after, 0.85 * before);
+}
+
+}  // namespace
+}  // namespace ihs::tracker
+
+namespace ihs::tracker {
+namespace {
+
+// Tracks frames [0, frames) of a sequence from the true first pose, each fit starting from a
+// constant-velocity prediction; returns the mean joint error (mm).
+double TrackFromTheFirstPose(const synth::SequenceOptions& options) {
+  synth::SequenceRenderer renderer(options);
+  const HandModel& model = renderer.hand();
+  const Segmenter segmenter(options.intrinsics);
+  const HandFitter fitter(model, options.intrinsics);
+  HandPose pose = PoseFromBoneTransforms(model, renderer.Render(0).cam_from_bone);
+  HandPose previous = pose;
+  double sum = 0, worst = 0;
+  for (int i = 0; i < renderer.frame_count(); ++i) {
+    const synth::RenderedFrame rendered = renderer.Render(i);
+    HandPose predicted = pose;
+    predicted.cam_from_root =
+        pose.cam_from_root * previous.cam_from_root.Inverse() * pose.cam_from_root;
+    const HandFitResult fit =
+        fitter.Fit(segmenter.Segment(rendered.frame).hand_points, &rendered.frame, predicted);
+    previous = pose;
+    pose = fit.pose;
+    const double error = MeanJointError(model, pose, rendered.joints_mm);
+    sum += error;
+    worst = std::max(worst, error);
+  }
+  std::printf("%s, %s: mean joint error %.2f mm, worst %.2f mm over %d frames\n",
+              options.object.c_str(), options.motion.c_str(), sum / renderer.frame_count(), worst,
+              renderer.frame_count());
+  return sum / renderer.frame_count();
+}
+
+TEST(HandFitterTest, TracksTheRealHandOfARecordedSession) {
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent";
+  synth::SequenceOptions options;
+  options.object = "sphere";
+  options.motion = "recorded:" + (data / "sequences" / "004-sphere").string();
+  options.last_frame = 90;
+  // Measured: 1.44 mm mean, 2.44 mm worst over frames 0–150 (same model as rendered).
+  EXPECT_LT(TrackFromTheFirstPose(options), 3.0);
+}
+
+TEST(HandFitterTest, TracksTheScriptedMotionCoarsely) {
+  synth::SequenceOptions options;
+  options.object = "sphere";
+  options.scripted.frames = 240;
+  options.last_frame = 79;
+  // Measured 15.8 mm mean over 240 frames: the hand holds the object from behind, mostly hidden,
+  // and its wrist drifts. A regression guard until the tracker issue's recovery lands.
+  EXPECT_LT(TrackFromTheFirstPose(options), 25.0);
+}
+
+}  // namespace
+}  // namespace ihs::tracker

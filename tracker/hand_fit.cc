@@ -1,0 +1,401 @@
+#include "tracker/hand_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/check.h"
+#include "tracker/hand_fit_cost.h"
+#include "tracker/point_kd_tree.h"
+
+namespace ihs::tracker {
+namespace {
+
+constexpr double kCoverageMm = 10.0;
+// Collision pairs are kept when their capsules are closer than this beyond touching, mm.
+constexpr double kCollisionMarginMm = 5.0;
+// A model point counts as hidden when the depth image sees something this much nearer, mm.
+constexpr double kOccluderMm = 15.0;
+// Collision capsules are thinner than the fingers: fingers that touch (as neighbours do) are not
+// penalised, only fingers that pass into each other.
+constexpr double kCapsuleShrink = 0.7;
+
+// Closest points of segments [p0, p1] and [q0, q1]: parameters s, t in [0, 1].
+void ClosestPointsOfSegments(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                             const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, double* s,
+                             double* t) {
+  const Eigen::Vector3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  const double c = d1.dot(r), b = d1.dot(d2), denominator = a * e - b * b;
+  *s = denominator > 1e-12 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  *t = e > 1e-12 ? (b * *s + f) / e : 0.0;
+  if (*t < 0) {
+    *t = 0;
+    *s = a > 1e-12 ? std::clamp(-c / a, 0.0, 1.0) : 0.0;
+  } else if (*t > 1) {
+    *t = 1;
+    *s = a > 1e-12 ? std::clamp((b - c) / a, 0.0, 1.0) : 0.0;
+  }
+}
+
+}  // namespace
+
+HandFitCost::HandFitCost(const HandModel& model, const Eigen::Matrix3d& reference_rotation,
+                         std::vector<PointPair> pairs, std::vector<PlanePair> planes,
+                         std::vector<CollisionPair> collisions, double collision_weight,
+                         double limit_weight, double prior_weight, std::vector<double> prior_rad)
+    : model_(model),
+      reference_(reference_rotation),
+      pairs_(std::move(pairs)),
+      planes_(std::move(planes)),
+      collisions_(std::move(collisions)),
+      collision_sqrt_(std::sqrt(collision_weight)),
+      limit_weight_(limit_weight),
+      prior_weight_(prior_weight),
+      prior_(std::move(prior_rad)),
+      dofs_(JointDegreesOfFreedom(model)),
+      derivatives_(model) {
+  IHS_CHECK(prior_.size() == dofs_.size(),
+            "prior has " << prior_.size() << " angles, the model " << dofs_.size());
+  const int n = derivatives_.size();
+  set_num_residuals(
+      static_cast<int>(3 * pairs_.size() + planes_.size() + collisions_.size() + 2 * dofs_.size()));
+  mutable_parameter_block_sizes()->push_back(n);
+}
+
+bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
+                           double** jacobians) const {
+  const double* x = parameters[0];
+  const int n = derivatives_.size();
+  derivatives_.Evaluate(reference_, x);
+  double* jacobian = jacobians ? jacobians[0] : nullptr;
+  if (jacobian) std::fill(jacobian, jacobian + static_cast<size_t>(num_residuals()) * n, 0.0);
+  int row = 0;
+  std::vector<double> point_jacobian(3 * n);
+  for (const PointPair& pair : pairs_) {
+    const Eigen::Vector3d p = derivatives_.SkinnedPoint(model_.weights[pair.vertex],
+                                                        model_.rest_mesh.vertices[pair.vertex],
+                                                        jacobian ? point_jacobian.data() : nullptr);
+    for (int r = 0; r < 3; ++r) {
+      residuals[row + r] = pair.weight * (p[r] - pair.target[r]);
+      if (jacobian) {
+        for (int c = 0; c < n; ++c)
+          jacobian[(row + r) * n + c] = pair.weight * point_jacobian[r * n + c];
+      }
+    }
+    row += 3;
+  }
+  for (const PlanePair& pair : planes_) {
+    const Eigen::Vector3d p = derivatives_.SkinnedPoint(model_.weights[pair.vertex],
+                                                        model_.rest_mesh.vertices[pair.vertex],
+                                                        jacobian ? point_jacobian.data() : nullptr);
+    residuals[row] = pair.weight * pair.normal.dot(p - pair.target);
+    if (jacobian) {
+      for (int c = 0; c < n; ++c) {
+        double d = 0;
+        for (int r = 0; r < 3; ++r) d += pair.normal[r] * point_jacobian[r * n + c];
+        jacobian[row * n + c] = pair.weight * d;
+      }
+    }
+    ++row;
+  }
+  std::vector<double> jacobian_b(3 * n);
+  for (const CollisionPair& pair : collisions_) {
+    const Eigen::Vector3d a = derivatives_.BonePoint(pair.bone_a, pair.point_a,
+                                                     jacobian ? point_jacobian.data() : nullptr);
+    const Eigen::Vector3d b =
+        derivatives_.BonePoint(pair.bone_b, pair.point_b, jacobian ? jacobian_b.data() : nullptr);
+    const double distance = (a - b).norm();
+    const double depth = pair.radius_a + pair.radius_b - distance;
+    residuals[row] = depth > 0 ? collision_sqrt_ * depth : 0.0;
+    if (jacobian && depth > 0 && distance > 1e-9) {
+      const Eigen::Vector3d normal = (a - b) / distance;
+      for (int c = 0; c < n; ++c) {
+        double d = 0;
+        for (int r = 0; r < 3; ++r)
+          d += normal[r] * (point_jacobian[r * n + c] - jacobian_b[r * n + c]);
+        jacobian[row * n + c] = -collision_sqrt_ * d;
+      }
+    }
+    ++row;
+  }
+  for (size_t k = 0; k < dofs_.size(); ++k) {
+    const auto [lo_deg, hi_deg] = model_.limits[dofs_[k].bone].limits_deg[dofs_[k].axis];
+    const double angle = x[6 + k], lo = lo_deg * M_PI / 180, hi = hi_deg * M_PI / 180;
+    const double excess = angle > hi ? angle - hi : (angle < lo ? angle - lo : 0.0);
+    residuals[row] = limit_weight_ * excess;
+    if (jacobian && excess != 0) jacobian[row * n + 6 + k] = limit_weight_;
+    ++row;
+    residuals[row] = prior_weight_ * (angle - prior_[k]);
+    if (jacobian) jacobian[row * n + 6 + k] = prior_weight_;
+    ++row;
+  }
+  return true;
+}
+
+void HandFitOptions::Check() const {
+  IHS_CHECK_ARG(collision_weight >= 0, "hand_fit.collision_weight must be >= 0");
+  IHS_CHECK_ARG(outer_iterations >= 1 && inner_iterations >= 1,
+                "hand_fit.outer_iterations and inner_iterations must be >= 1");
+  IHS_CHECK_ARG(max_data_points >= 10 && max_model_points >= 10,
+                "hand_fit.max_data_points and max_model_points must be >= 10");
+  IHS_CHECK_ARG(max_correspondence_mm > 0 && robust_scale_mm > 0,
+                "hand_fit.max_correspondence_mm and robust_scale_mm must be positive");
+  IHS_CHECK_ARG(limit_weight >= 0 && prior_weight >= 0,
+                "hand_fit.limit_weight and prior_weight must be >= 0");
+  IHS_CHECK_ARG(initial_trust_radius > 0, "hand_fit.initial_trust_radius must be positive");
+}
+
+// Precomputed per model: sample vertices and collision capsules.
+struct HandFitter::Data {
+  std::vector<int> samples;      // Model vertices used for correspondences.
+  std::vector<int> sample_bone;  // Dominant bone of each sample (for its normal).
+  std::vector<Eigen::Vector3d> rest_normal_in_bone;  // Each sample's normal in that bone's frame.
+  struct Capsule {
+    int bone;
+    int finger;
+    double length;
+    double radius;
+  };
+  std::vector<Capsule> capsules;
+};
+
+HandFitter::HandFitter(const HandModel& model, const CameraIntrinsics& intrinsics,
+                       HandFitOptions options)
+    : model_(model),
+      intrinsics_(intrinsics),
+      options_(std::move(options)),
+      data_(std::make_unique<Data>()) {
+  options_.Check();
+  model_.Check();
+  const size_t vertices = model.rest_mesh.vertices.size();
+  const size_t stride = std::max<size_t>(1, vertices / 3000);
+  std::vector<int> dominant(vertices, 0);
+  for (size_t v = 0; v < vertices; ++v) {
+    float best = -1;
+    for (const auto& [bone, weight] : model.weights[v].bones) {
+      if (weight > best) best = weight, dominant[v] = bone;
+    }
+  }
+  // Vertex normals of the rest mesh (loaded meshes may come without).
+  TriangleMesh rest = model.rest_mesh;
+  if (rest.normals.size() != vertices) rest.ComputeVertexNormals();
+  for (size_t v = 0; v < vertices; v += stride) {
+    data_->samples.push_back(static_cast<int>(v));
+    data_->sample_bone.push_back(dominant[v]);
+    const Eigen::Vector3d normal = rest.normals[v].cast<double>();
+    data_->rest_normal_in_bone.push_back(
+        model.model_from_bone_rest[dominant[v]].Inverse().RotateVector(normal));
+  }
+  // Capsules on the phalanges and the thumb's metacarpal (the other metacarpals lie in the palm):
+  // radius = median distance of the bone's own vertices from its axis.
+  for (int b = 1; b < static_cast<int>(model.bones.size()); ++b) {
+    const int finger = model.FingerOf(b);
+    const std::string& name = model.bones[b].name;
+    const bool metacarpal = name.size() >= 4 && name.substr(name.size() - 4) == "Hand";
+    if (finger < 0 || (metacarpal && finger != 4)) continue;
+    const double length = model.bones[b].length_mm;
+    const Rigid3 bone_from_model = model.model_from_bone_rest[b].Inverse();
+    std::vector<double> distances;
+    for (size_t v = 0; v < vertices; ++v) {
+      if (dominant[v] != b) continue;
+      const Eigen::Vector3d p =
+          bone_from_model * Eigen::Vector3d(model.rest_mesh.vertices[v].cast<double>());
+      const double s = std::clamp(p.x(), 0.0, length);
+      distances.push_back((p - Eigen::Vector3d(s, 0, 0)).norm());
+    }
+    if (distances.empty()) continue;
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    data_->capsules.push_back(
+        {b, finger, length, kCapsuleShrink * distances[distances.size() / 2]});
+  }
+}
+
+HandFitter::~HandFitter() = default;
+
+HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
+                              const HandPose& initial) const {
+  HandFitResult result;
+  result.pose = initial;
+  if (hand_points.empty()) return result;
+
+  // Data: an even subsample for data → model, a denser one for the tree.
+  const size_t data_stride =
+      std::max<size_t>(1, hand_points.size() / static_cast<size_t>(options_.max_data_points));
+  std::vector<Eigen::Vector3f> data;
+  for (size_t i = 0; i < hand_points.size(); i += data_stride) data.push_back(hand_points[i]);
+  const size_t tree_stride = std::max<size_t>(1, hand_points.size() / 4000);
+  std::vector<Eigen::Vector3f> tree_points;
+  for (size_t i = 0; i < hand_points.size(); i += tree_stride)
+    tree_points.push_back(hand_points[i]);
+  const PointKdTree data_tree(std::move(tree_points));
+  result.data_points = static_cast<int>(data.size());
+
+  PoseDerivatives kinematics(model_);
+  const std::vector<double> prior = initial.angles_rad;
+  HandPose pose = initial;
+  const int samples = static_cast<int>(data_->samples.size());
+  std::vector<Eigen::Vector3f> posed(samples);
+  std::vector<Eigen::Vector3d> normals(samples);
+  std::vector<bool> visible(samples, false);
+  std::vector<int> facing;  // Samples facing the camera.
+  auto pose_samples = [&](const HandPose& at) {
+    const PoseParameters parameters(at);
+    kinematics.Evaluate(parameters.reference_rotation(), parameters.values().data());
+    const auto& cam_from_bone = kinematics.cam_from_bone();
+    facing.clear();
+    for (int i = 0; i < samples; ++i) {
+      const int v = data_->samples[i];
+      const int bone = data_->sample_bone[i];
+      posed[i] = kinematics.SkinnedPoint(model_.weights[v], model_.rest_mesh.vertices[v], nullptr)
+                     .cast<float>();
+      normals[i] = cam_from_bone[bone].RotateVector(data_->rest_normal_in_bone[i]);
+      if (normals[i].dot(posed[i].cast<double>()) < 0) facing.push_back(i);
+    }
+  };
+  // Visible samples: facing the camera, in front in a coarse depth buffer of the model (8 px
+  // cells), and — with a depth image — not hidden behind something nearer (the object).
+  auto find_visible = [&]() {
+    const int cw = (intrinsics_.width + 7) / 8, ch = (intrinsics_.height + 7) / 8;
+    std::vector<float> nearest(static_cast<size_t>(cw) * ch,
+                               std::numeric_limits<float>::infinity());
+    std::vector<int> cell(samples, -1);
+    std::vector<Eigen::Vector2d> pixel(samples);
+    for (int i : facing) {
+      const Eigen::Vector3d p = posed[i].cast<double>();
+      if (p.z() <= 1) continue;
+      pixel[i] = intrinsics_.Project(p);
+      const int cu = static_cast<int>(std::floor(pixel[i].x() / 8));
+      const int cv = static_cast<int>(std::floor(pixel[i].y() / 8));
+      if (cu < 0 || cv < 0 || cu >= cw || cv >= ch) continue;
+      cell[i] = cv * cw + cu;
+      nearest[cell[i]] = std::min(nearest[cell[i]], posed[i].z());
+    }
+    std::vector<int> out;
+    std::fill(visible.begin(), visible.end(), false);
+    for (int i : facing) {
+      if (cell[i] < 0 || posed[i].z() > nearest[cell[i]] + 8.0f) continue;
+      if (frame) {
+        const int u = static_cast<int>(std::lround(pixel[i].x()));
+        const int v = static_cast<int>(std::lround(pixel[i].y()));
+        // Outside the image, or behind something nearer: hidden. Where the image has no depth
+        // (background) the point stays: the model must not leave the hand's silhouette.
+        if (u < 0 || v < 0 || u >= frame->width || v >= frame->height) continue;
+        const std::uint16_t z = frame->depth_mm[static_cast<size_t>(v) * frame->width + u];
+        if (z != 0 && z < posed[i].z() - kOccluderMm) continue;
+      }
+      visible[i] = true;
+      out.push_back(i);
+    }
+    return out;
+  };
+  auto huber = [&](double distance) {
+    return distance <= options_.robust_scale_mm ? 1.0
+                                                : std::sqrt(options_.robust_scale_mm / distance);
+  };
+
+  std::vector<int> visible_samples;
+  for (int outer = 0; outer < options_.outer_iterations; ++outer) {
+    pose_samples(pose);
+    visible_samples = find_visible();
+    const auto& cam_from_bone = kinematics.cam_from_bone();
+
+    // Model → data: visible samples to their nearest data point.
+    const size_t model_stride = std::max<size_t>(
+        1, visible_samples.size() / static_cast<size_t>(options_.max_model_points));
+    std::vector<PointPair> model_pairs;
+    for (size_t k = 0; k < visible_samples.size(); k += model_stride) {
+      const int i = visible_samples[k];
+      float d2 = 0;
+      const int j = data_tree.Nearest(posed[i], &d2);
+      const double d = std::sqrt(d2);
+      if (j < 0 || d > options_.max_correspondence_mm) continue;
+      model_pairs.push_back({data_->samples[i], data_tree.points()[j].cast<double>(), huber(d)});
+    }
+    // Data → model: data points to the tangent plane of their nearest sample facing the camera.
+    std::vector<Eigen::Vector3f> facing_points;
+    for (int i : facing) facing_points.push_back(posed[i]);
+    const PointKdTree model_tree(std::move(facing_points));
+    std::vector<PlanePair> data_pairs;
+    for (const Eigen::Vector3f& point : data) {
+      float d2 = 0;
+      const int k = model_tree.Nearest(point, &d2);
+      const double d = std::sqrt(d2);
+      if (k < 0 || d > options_.max_correspondence_mm) continue;
+      const int i = facing[k];
+      data_pairs.push_back({data_->samples[i], point.cast<double>(), normals[i], huber(d)});
+    }
+    if (model_pairs.empty() && data_pairs.empty()) break;
+    // Each direction is a mean over its pairs.
+    const double model_scale =
+        model_pairs.empty() ? 0 : 1.0 / std::sqrt(double(model_pairs.size()));
+    for (PointPair& pair : model_pairs) pair.weight *= model_scale;
+    const double data_scale = data_pairs.empty() ? 0 : 1.0 / std::sqrt(double(data_pairs.size()));
+    for (PlanePair& pair : data_pairs) pair.weight *= data_scale;
+
+    // Collisions between capsules of different fingers that are close now.
+    std::vector<CollisionPair> collisions;
+    for (size_t a = 0; a < data_->capsules.size(); ++a) {
+      for (size_t b = a + 1; b < data_->capsules.size(); ++b) {
+        const auto& ca = data_->capsules[a];
+        const auto& cb = data_->capsules[b];
+        if (ca.finger == cb.finger) continue;
+        const Rigid3& ta = cam_from_bone[ca.bone];
+        const Rigid3& tb = cam_from_bone[cb.bone];
+        double s, t;
+        ClosestPointsOfSegments(ta.translation(), ta * Eigen::Vector3d(ca.length, 0, 0),
+                                tb.translation(), tb * Eigen::Vector3d(cb.length, 0, 0), &s, &t);
+        const Eigen::Vector3d pa(s * ca.length, 0, 0), pb(t * cb.length, 0, 0);
+        if ((ta * pa - tb * pb).norm() > ca.radius + cb.radius + kCollisionMarginMm) continue;
+        collisions.push_back({ca.bone, pa, ca.radius, cb.bone, pb, cb.radius});
+      }
+    }
+
+    PoseParameters parameters(pose);
+    ceres::Problem problem;
+    problem.AddResidualBlock(
+        new HandFitCost(model_, parameters.reference_rotation(), std::move(model_pairs),
+                        std::move(data_pairs), std::move(collisions), options_.collision_weight,
+                        options_.limit_weight, options_.prior_weight, prior),
+        nullptr, parameters.values().data());
+    ceres::Solver::Options solver;
+    solver.linear_solver_type = ceres::DENSE_QR;
+    solver.max_num_iterations = options_.inner_iterations;
+    // Correspondences hold only near the current pose: start with modest steps.
+    solver.initial_trust_region_radius = options_.initial_trust_radius;
+    solver.num_threads = 1;
+    solver.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+    pose = parameters.ToPose();
+  }
+
+  // How well the final pose explains the data, and the data the model.
+  pose_samples(pose);
+  visible_samples = find_visible();
+  std::vector<Eigen::Vector3f> facing_points;
+  for (int i : facing) facing_points.push_back(posed[i]);
+  const PointKdTree model_tree(std::move(facing_points));
+  double sum = 0;
+  int covered = 0;
+  for (const Eigen::Vector3f& point : data) {
+    float d2 = 0;
+    if (model_tree.Nearest(point, &d2) < 0) d2 = 1e6f;
+    sum += std::sqrt(d2);
+    covered += std::sqrt(d2) <= kCoverageMm;
+  }
+  int visible_covered = 0;
+  for (int i : visible_samples) {
+    float d2 = 0;
+    data_tree.Nearest(posed[i], &d2);
+    visible_covered += std::sqrt(d2) <= kCoverageMm;
+  }
+  result.pose = pose;
+  result.data_error_mm = sum / data.size();
+  result.data_coverage = static_cast<double>(covered) / data.size();
+  result.model_coverage =
+      visible_samples.empty() ? 0 : static_cast<double>(visible_covered) / visible_samples.size();
+  return result;
+}
+
+}  // namespace ihs::tracker

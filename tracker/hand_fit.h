@@ -1,0 +1,83 @@
+#pragma once
+// Hand pose fitting to the hand's depth points, as in the paper (and Tzionas et al., GCPR 2014):
+// E(θ) = E_model→data + E_data→model + γc·E_collision with soft joint limits, minimised by
+// iterated closest points: correspondences are recomputed in each outer iteration and the inner
+// least-squares problem is solved with Ceres (Levenberg–Marquardt, analytic derivatives).
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "tracker/hand_model.h"
+#include "tracker/hand_pose.h"
+
+namespace ihs::tracker {
+
+/// Options of the hand fit (defaults: the paper's γc; the rest tuned on generator sequences of
+/// the scripted motion and checked on the recorded ones).
+struct HandFitOptions {
+  /// γc, weight of the collision term (paper: 10).
+  double collision_weight = 10.0;
+  /// Correspondence updates per frame, and Levenberg–Marquardt iterations per update.
+  int outer_iterations = 4;
+  int inner_iterations = 5;
+  /// Data points matched to the model (data → model) and visible model points matched to the
+  /// data (model → data), at most; both are subsampled evenly.
+  int max_data_points = 300;
+  int max_model_points = 300;
+  /// Pairs farther apart than this are dropped, mm.
+  double max_correspondence_mm = 40.0;
+  /// Pairs farther apart than this count with a Huber weight, mm.
+  double robust_scale_mm = 8.0;
+  /// Weight of soft joint limits (per rad beyond a limit) and of the pull toward the initial
+  /// (predicted) joint angles (per rad), which keeps unseen fingers where they were.
+  double limit_weight = 30.0;
+  double prior_weight = 1.5;
+  /// Initial Levenberg–Marquardt trust region: correspondences hold only near the current pose.
+  double initial_trust_radius = 10.0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// The fitted pose and how well it explains the data.
+struct HandFitResult {
+  HandPose pose;
+  /// Mean distance of the (subsampled) data points to the nearest model point, mm.
+  double data_error_mm = 0;
+  /// Share of data points within 10 mm of the model, and of visible model points within 10 mm
+  /// of the data.
+  double data_coverage = 0;
+  double model_coverage = 0;
+  /// Data points used.
+  int data_points = 0;
+};
+
+/// Fits a hand model to hand points. Holds the model (by reference: it must outlive the
+/// fitter) and its collision proxies.
+class HandFitter {
+ public:
+  HandFitter(const HandModel& model, const CameraIntrinsics& intrinsics,
+             HandFitOptions options = {});
+  ~HandFitter();
+
+  /// Fits from `initial` (e.g. the previous pose, or a prediction) to `hand_points` (camera
+  /// frame, mm). `frame` (optional) is the depth image they came from: model points hidden
+  /// behind nearer surfaces (the object) are then not matched. With no points the initial pose
+  /// comes back with zero coverage.
+  HandFitResult Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
+                    const HandPose& initial) const;
+
+  const HandFitOptions& options() const { return options_; }
+
+ private:
+  struct Data;
+  const HandModel& model_;
+  const CameraIntrinsics intrinsics_;
+  const HandFitOptions options_;
+  std::unique_ptr<Data> data_;
+};
+
+}  // namespace ihs::tracker

@@ -1,0 +1,70 @@
+#pragma once
+// Internal to the tracker (included by hand_fit.cc and its test only, as it brings in Ceres): the
+// least-squares cost of one inner hand-fit problem, with analytic derivatives.
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "tracker/hand_kinematics.h"
+#include "tracker/hand_model.h"
+
+namespace ihs::tracker {
+
+/// A model vertex that should lie at `target` (camera frame, mm), weighted.
+struct PointPair {
+  int vertex = 0;
+  Eigen::Vector3d target;
+  double weight = 1.0;
+};
+
+/// A model vertex that should lie on the plane through `target` with unit `normal` (camera
+/// frame), weighted: a point-to-plane pair.
+struct PlanePair {
+  int vertex = 0;
+  Eigen::Vector3d target;
+  Eigen::Vector3d normal;
+  double weight = 1.0;
+};
+
+/// Two capsules (points on their axes fixed in their bones' frames) that must stay apart by the
+/// sum of their radii.
+struct CollisionPair {
+  int bone_a = 0;
+  Eigen::Vector3d point_a;
+  double radius_a = 0;
+  int bone_b = 0;
+  Eigen::Vector3d point_b;
+  double radius_b = 0;
+};
+
+/// Residuals: for each point pair w·(x_v − target) (3), for each plane pair w·n·(x_v − target),
+/// for each collision √γc·max(0, r_a + r_b −
+/// |A − B|), for each joint angle the soft limit excess (limit_weight per rad) and the pull
+/// toward `prior_rad` (prior_weight per rad). One parameter block: the PoseParameters vector.
+class HandFitCost : public ceres::CostFunction {
+ public:
+  HandFitCost(const HandModel& model, const Eigen::Matrix3d& reference_rotation,
+              std::vector<PointPair> pairs, std::vector<PlanePair> planes,
+              std::vector<CollisionPair> collisions, double collision_weight, double limit_weight,
+              double prior_weight, std::vector<double> prior_rad);
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const HandModel& model_;
+  const Eigen::Matrix3d reference_;
+  const std::vector<PointPair> pairs_;
+  const std::vector<PlanePair> planes_;
+  const std::vector<CollisionPair> collisions_;
+  const double collision_sqrt_;
+  const double limit_weight_;
+  const double prior_weight_;
+  const std::vector<double> prior_;
+  const std::vector<DegreeOfFreedom> dofs_;
+  mutable PoseDerivatives derivatives_;
+};
+
+}  // namespace ihs::tracker
