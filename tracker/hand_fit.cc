@@ -1,5 +1,6 @@
 #include "tracker/hand_fit.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -396,6 +397,107 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   result.model_coverage =
       visible_samples.empty() ? 0 : static_cast<double>(visible_covered) / visible_samples.size();
   return result;
+}
+
+namespace {
+
+// Residuals: joint positions minus targets (3 per joint), soft limits, a weak pull to zero angles.
+class JointCost : public ceres::CostFunction {
+ public:
+  JointCost(const HandModel& model, const Eigen::Matrix3d& reference,
+            std::vector<Eigen::Vector3d> targets)
+      : model_(model),
+        reference_(reference),
+        targets_(std::move(targets)),
+        dofs_(JointDegreesOfFreedom(model)),
+        derivatives_(model) {
+    set_num_residuals(static_cast<int>(3 * targets_.size() + 2 * dofs_.size()));
+    mutable_parameter_block_sizes()->push_back(derivatives_.size());
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* x = parameters[0];
+    const int n = derivatives_.size();
+    derivatives_.Evaluate(reference_, x);
+    double* jacobian = jacobians ? jacobians[0] : nullptr;
+    if (jacobian) std::fill(jacobian, jacobian + static_cast<size_t>(num_residuals()) * n, 0.0);
+    std::vector<double> point_jacobian(3 * n);
+    for (size_t j = 0; j < targets_.size(); ++j) {
+      const int bone = j == 0 ? 0 : static_cast<int>(j) - 1;
+      const Eigen::Vector3d local(j == 0 ? 0.0 : model_.bones[bone].length_mm, 0, 0);
+      const Eigen::Vector3d p =
+          derivatives_.BonePoint(bone, local, jacobian ? point_jacobian.data() : nullptr);
+      for (int r = 0; r < 3; ++r) {
+        residuals[3 * j + r] = p[r] - targets_[j][r];
+        if (jacobian) {
+          std::copy(point_jacobian.begin() + r * n, point_jacobian.begin() + (r + 1) * n,
+                    jacobian + (3 * j + r) * n);
+        }
+      }
+    }
+    int row = static_cast<int>(3 * targets_.size());
+    for (size_t k = 0; k < dofs_.size(); ++k) {
+      const auto [lo_deg, hi_deg] = model_.limits[dofs_[k].bone].limits_deg[dofs_[k].axis];
+      const double angle = x[6 + k], lo = lo_deg * M_PI / 180, hi = hi_deg * M_PI / 180;
+      const double excess = angle > hi ? angle - hi : (angle < lo ? angle - lo : 0.0);
+      residuals[row] = 30.0 * excess;
+      if (jacobian && excess != 0) jacobian[row * n + 6 + k] = 30.0;
+      ++row;
+      residuals[row] = 0.5 * angle;
+      if (jacobian) jacobian[row * n + 6 + k] = 0.5;
+      ++row;
+    }
+    return true;
+  }
+
+ private:
+  const HandModel& model_;
+  const Eigen::Matrix3d reference_;
+  const std::vector<Eigen::Vector3d> targets_;
+  const std::vector<DegreeOfFreedom> dofs_;
+  mutable PoseDerivatives derivatives_;
+};
+
+}  // namespace
+
+HandPose FitPoseToJoints(const HandModel& model, const std::vector<Eigen::Vector3d>& joints_mm) {
+  IHS_CHECK_ARG(
+      joints_mm.size() == model.bones.size() + 1,
+      "FitPoseToJoints needs " << model.bones.size() + 1 << " joints, got " << joints_mm.size());
+  // Start: the rest pose placed by the best rigid fit of its joints to the targets.
+  const HandPose rest = HandPose::Rest(model);
+  const std::vector<Eigen::Vector3d> rest_joints =
+      model.JointPositions(ForwardKinematics(model, rest));
+  Eigen::Vector3d mean_rest = Eigen::Vector3d::Zero(), mean_target = Eigen::Vector3d::Zero();
+  for (size_t j = 0; j < joints_mm.size(); ++j)
+    mean_rest += rest_joints[j], mean_target += joints_mm[j];
+  mean_rest /= joints_mm.size(), mean_target /= joints_mm.size();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (size_t j = 0; j < joints_mm.size(); ++j)
+    covariance += (joints_mm[j] - mean_target) * (rest_joints[j] - mean_rest).transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d flip = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) flip(2, 2) = -1;
+  const Eigen::Matrix3d rotation = svd.matrixU() * flip * svd.matrixV().transpose();
+  const Rigid3 cam_from_model(rotation, mean_target - rotation * mean_rest);
+  HandPose start = HandPose::Rest(model, cam_from_model);
+
+  HandPose pose = start;
+  for (int round = 0; round < 3; ++round) {  // Re-centre ω between rounds.
+    PoseParameters parameters(pose);
+    ceres::Problem problem;
+    problem.AddResidualBlock(new JointCost(model, parameters.reference_rotation(), joints_mm),
+                             nullptr, parameters.values().data());
+    ceres::Solver::Options solver;
+    solver.linear_solver_type = ceres::DENSE_QR;
+    solver.max_num_iterations = 50;
+    solver.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+    pose = parameters.ToPose();
+  }
+  return pose;
 }
 
 }  // namespace ihs::tracker

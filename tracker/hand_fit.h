@@ -80,4 +80,9 @@ class HandFitter {
   std::unique_ptr<Data> data_;
 };
 
+/// The pose of `model` whose 21 joints (HandModel::JointPositions) best match `joints_mm`
+/// (camera frame), within soft joint limits: how a template of other proportions (the
+/// procedural hand) takes over a pose known as joint positions (ground truth, another model).
+HandPose FitPoseToJoints(const HandModel& model, const std::vector<Eigen::Vector3d>& joints_mm);
+
 }  // namespace ihs::tracker

@@ -1,0 +1,75 @@
+#include "tracker/contacts.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+#include "tracker/point_kd_tree.h"
+
+namespace ihs::tracker {
+
+void ContactOptions::Check() const {
+  IHS_CHECK_ARG(start_mm > 0 && step_mm > 0 && max_mm >= start_mm,
+                "contacts: start_mm and step_mm must be positive and max_mm >= start_mm");
+  IHS_CHECK_ARG(min_vertices >= 1 && reference_fingertip_vertices >= 1,
+                "contacts.min_vertices and reference_fingertip_vertices must be >= 1");
+  IHS_CHECK_ARG(min_bones >= 1 && min_bones <= 5, "contacts.min_bones must be in [1, 5]");
+}
+
+ContactDetector::ContactDetector(const HandModel& model, ContactOptions options)
+    : options_(std::move(options)), end_effectors_(model.EndEffectors()) {
+  options_.Check();
+  fingertip_vertices_.resize(end_effectors_.size());
+  for (size_t v = 0; v < model.weights.size(); ++v) {
+    int best = -1;
+    float best_weight = -1;
+    for (const auto& [bone, weight] : model.weights[v].bones) {
+      if (weight > best_weight) best = bone, best_weight = weight;
+    }
+    const auto it = std::find(end_effectors_.begin(), end_effectors_.end(), best);
+    if (it != end_effectors_.end()) {
+      fingertip_vertices_[it - end_effectors_.begin()].push_back(static_cast<int>(v));
+    }
+  }
+  for (const auto& vertices : fingertip_vertices_) {
+    min_vertices_.push_back(std::max(
+        1, static_cast<int>(std::lround(static_cast<double>(options_.min_vertices) *
+                                        vertices.size() / options_.reference_fingertip_vertices))));
+  }
+}
+
+Contacts ContactDetector::Detect(const std::vector<Eigen::Vector3f>& posed_vertices,
+                                 const PointKdTree& object_points) const {
+  Contacts contacts;
+  // Distance of every fingertip vertex to the object, once.
+  std::vector<std::vector<float>> distances(end_effectors_.size());
+  for (size_t e = 0; e < end_effectors_.size(); ++e) {
+    for (int v : fingertip_vertices_[e]) {
+      float d2 = 0;
+      distances[e].push_back(object_points.Nearest(posed_vertices[v], &d2) >= 0 ? std::sqrt(d2)
+                                                                                : 1e9f);
+    }
+  }
+  for (double threshold = options_.start_mm; threshold <= options_.max_mm + 1e-9;
+       threshold += options_.step_mm) {
+    contacts.bones.clear();
+    contacts.threshold_mm = threshold;
+    for (size_t e = 0; e < end_effectors_.size(); ++e) {
+      const auto close = std::count_if(distances[e].begin(), distances[e].end(),
+                                       [&](float d) { return d <= threshold; });
+      if (close > min_vertices_[e]) contacts.bones.push_back(end_effectors_[e]);
+    }
+    if (static_cast<int>(contacts.bones.size()) >= options_.min_bones) break;
+  }
+  for (size_t e = 0; e < end_effectors_.size(); ++e) {
+    if (std::find(contacts.bones.begin(), contacts.bones.end(), end_effectors_[e]) ==
+        contacts.bones.end()) {
+      continue;
+    }
+    contacts.vertices.insert(contacts.vertices.end(), fingertip_vertices_[e].begin(),
+                             fingertip_vertices_[e].end());
+  }
+  return contacts;
+}
+
+}  // namespace ihs::tracker

@@ -1,0 +1,65 @@
+#pragma once
+// Contact points exactly as the paper defines them: for each end-effector (distal phalanx),
+// count its vertices within `threshold` of the nearest object point; more than `min_vertices`
+// makes it a contact bone and all its vertices contact vertices. With fewer than `min_bones`
+// contact bones, the threshold grows by `step_mm` and the count is repeated (up to `max_mm`).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "tracker/hand_model.h"
+
+namespace ihs::tracker {
+
+class PointKdTree;
+
+/// Options of the contact detection (defaults: the paper's, with the growth bounded at 6 mm:
+/// where a fingertip pinches an object from the side, the camera sees little of the object's
+/// surface under it).
+struct ContactOptions {
+  /// First distance threshold, its growth per retry and its largest value, mm.
+  double start_mm = 1.0;
+  double step_mm = 0.5;
+  double max_mm = 6.0;
+  /// Vertices within the threshold that make a contact bone, for a fingertip of
+  /// `reference_fingertip_vertices` (the paper's hand model: 40 of about 350); templates with
+  /// coarser or finer fingertips scale it by their own vertex count.
+  int min_vertices = 40;
+  int reference_fingertip_vertices = 350;
+  /// Contact bones wanted before the threshold stops growing.
+  int min_bones = 2;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// The contacts of one frame.
+struct Contacts {
+  /// End-effector bones in contact, and all their vertices (the contact vertices).
+  std::vector<int> bones;
+  std::vector<int> vertices;
+  /// The threshold at which they were found, mm (the last one tried when none were).
+  double threshold_mm = 0;
+};
+
+/// Finds contacts of a posed hand with the object's points.
+class ContactDetector {
+ public:
+  explicit ContactDetector(const HandModel& model, ContactOptions options = {});
+
+  /// `posed_vertices`: the hand's skin vertices in the camera frame (model vertex order);
+  /// `object_points`: a tree over the object's points (camera frame).
+  Contacts Detect(const std::vector<Eigen::Vector3f>& posed_vertices,
+                  const PointKdTree& object_points) const;
+
+  /// The vertices of each end-effector (those skinned mostly to it), EndEffectors order.
+  const std::vector<std::vector<int>>& fingertip_vertices() const { return fingertip_vertices_; }
+
+ private:
+  const ContactOptions options_;
+  std::vector<int> end_effectors_;
+  std::vector<std::vector<int>> fingertip_vertices_;
+  std::vector<int> min_vertices_;  // Per end-effector, scaled to its vertex count.
+};
+
+}  // namespace ihs::tracker

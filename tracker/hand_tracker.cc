@@ -1,0 +1,205 @@
+#include "tracker/hand_tracker.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include "core/check.h"
+#include "tracker/point_kd_tree.h"
+
+namespace ihs::tracker {
+namespace {
+
+// Principal axes (columns, by decreasing spread) and centroid of points.
+void PrincipalAxes(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d* centroid,
+                   Eigen::Matrix3d* axes) {
+  *centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) *centroid += p;
+  *centroid /= static_cast<double>(points.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) covariance += (p - *centroid) * (p - *centroid).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  // Eigen sorts ascending; reverse to largest first.
+  for (int k = 0; k < 3; ++k) axes->col(k) = solver.eigenvectors().col(2 - k);
+}
+
+}  // namespace
+
+const char* ToString(TrackStatus status) {
+  switch (status) {
+    case TrackStatus::kTracked:
+      return "tracked";
+    case TrackStatus::kInitialised:
+      return "initialised";
+    case TrackStatus::kDiverged:
+      return "diverged";
+    case TrackStatus::kNoHand:
+      return "no_hand";
+    case TrackStatus::kEmptyFrame:
+      return "empty_frame";
+  }
+  return "unknown";
+}
+
+void TrackerOptions::Check() const {
+  segmentation.Check();
+  fit.Check();
+  contacts.Check();
+  IHS_CHECK_ARG(min_hand_points >= 10, "tracker.min_hand_points must be >= 10");
+  IHS_CHECK_ARG(min_data_coverage >= 0 && min_data_coverage <= 1,
+                "tracker.min_data_coverage must be in [0, 1]");
+  IHS_CHECK_ARG(diverged_frames_to_reinitialise >= 1,
+                "tracker.diverged_frames_to_reinitialise must be >= 1");
+  IHS_CHECK_ARG(initialisation_iterations >= 1, "tracker.initialisation_iterations must be >= 1");
+}
+
+namespace {
+HandFitOptions InitialFitOptions(const TrackerOptions& options) {
+  HandFitOptions fit = options.fit;
+  fit.outer_iterations = options.initialisation_iterations;
+  fit.prior_weight = 0.5;
+  return fit;
+}
+}  // namespace
+
+HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
+                         TrackerOptions options)
+    : model_(std::move(model)),
+      intrinsics_(intrinsics),
+      options_((options.Check(), std::move(options))),
+      segmenter_(intrinsics, options_.segmentation),
+      fitter_(model_, intrinsics, options_.fit),
+      initial_fitter_(model_, intrinsics, InitialFitOptions(options_)),
+      contacts_(model_, options_.contacts) {}
+
+HandTracker::~HandTracker() = default;
+
+void HandTracker::Initialise(const HandPose& pose) {
+  pose_ = pose;
+  has_pose_ = true;
+  has_previous_ = false;
+  diverged_in_a_row_ = 0;
+}
+
+HandFitResult HandTracker::InitialiseFromCloud(const std::vector<Eigen::Vector3f>& hand_points,
+                                               const Frame& frame) const {
+  // Hypotheses: the model's principal axes (rest pose) onto the hand cloud's, each way round.
+  std::vector<Eigen::Vector3d> data, rest;
+  for (const auto& p : hand_points) data.push_back(p.cast<double>());
+  for (const auto& v : model_.Pose(ForwardKinematics(model_, HandPose::Rest(model_))).vertices)
+    rest.push_back(v.cast<double>());
+  Eigen::Vector3d data_centre, rest_centre;
+  Eigen::Matrix3d data_axes, rest_axes;
+  PrincipalAxes(data, &data_centre, &data_axes);
+  PrincipalAxes(rest, &rest_centre, &rest_axes);
+  if (rest_axes.determinant() < 0) rest_axes.col(2) *= -1;
+  // The cloud is the visible surface: the hand's middle lies a little farther along the ray.
+  const Eigen::Vector3d centre = data_centre + 8.0 * data_centre.normalized();
+  HandFitResult best;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (int s1 : {1, -1}) {
+    for (int s2 : {1, -1}) {
+      Eigen::Matrix3d axes;
+      axes.col(0) = s1 * data_axes.col(0);
+      axes.col(1) = s2 * data_axes.col(1);
+      axes.col(2) = axes.col(0).cross(axes.col(1));
+      const Eigen::Matrix3d rotation = axes * rest_axes.transpose();
+      const Rigid3 cam_from_model(rotation, centre - rotation * rest_centre);
+      const HandFitResult fit =
+          initial_fitter_.Fit(hand_points, &frame, HandPose::Rest(model_, cam_from_model));
+      const double score =
+          fit.data_error_mm + 20.0 * (1.0 - fit.data_coverage) + 20.0 * (1.0 - fit.model_coverage);
+      if (score < best_score) best_score = score, best = fit;
+    }
+  }
+  return best;
+}
+
+TrackResult HandTracker::Track(const Frame& frame) {
+  const auto started = std::chrono::steady_clock::now();
+  TrackResult result;
+  auto finish = [&]() {
+    result.milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+            .count();
+    return std::move(result);
+  };
+  if (std::all_of(frame.depth_mm.begin(), frame.depth_mm.end(),
+                  [](std::uint16_t z) { return z == 0; })) {
+    result.status = TrackStatus::kEmptyFrame;
+    result.reason = "empty depth image";
+    has_previous_ = false;
+    return finish();
+  }
+  result.segmentation = segmenter_.Segment(frame);
+  const auto& points = result.segmentation.hand_points;
+  if (static_cast<int>(points.size()) < options_.min_hand_points) {
+    result.status = TrackStatus::kNoHand;
+    result.reason = "no hand: " + std::to_string(points.size()) +
+                    " skin points in the crop volume (need " +
+                    std::to_string(options_.min_hand_points) + ")";
+    has_previous_ = false;
+    previous_contact_vertices_.clear();
+    return finish();
+  }
+
+  if (!has_pose_) {
+    result.fit = InitialiseFromCloud(points, frame);
+    result.status = TrackStatus::kInitialised;
+  } else {
+    HandPose predicted = pose_;
+    if (has_previous_) {
+      predicted.cam_from_root =
+          pose_.cam_from_root * previous_pose_.cam_from_root.Inverse() * pose_.cam_from_root;
+    }
+    result.fit = fitter_.Fit(points, &frame, predicted);
+    result.status = TrackStatus::kTracked;
+  }
+  if (result.fit.data_coverage < options_.min_data_coverage) {
+    ++diverged_in_a_row_;
+    if (result.status == TrackStatus::kTracked &&
+        diverged_in_a_row_ >= options_.diverged_frames_to_reinitialise) {
+      result.fit = InitialiseFromCloud(points, frame);
+      result.status = TrackStatus::kInitialised;
+    }
+  }
+  if (result.fit.data_coverage < options_.min_data_coverage) {
+    result.status = TrackStatus::kDiverged;
+    result.reason = "fit explains " +
+                    std::to_string(static_cast<int>(100 * result.fit.data_coverage)) +
+                    " % of the hand points";
+  } else {
+    diverged_in_a_row_ = 0;
+  }
+
+  previous_pose_ = pose_;
+  has_previous_ = has_pose_ && result.status == TrackStatus::kTracked;
+  pose_ = result.fit.pose;
+  has_pose_ = true;
+  result.pose = pose_;
+  const std::vector<Rigid3> cam_from_bone = ForwardKinematics(model_, pose_);
+  result.joints_mm = model_.JointPositions(cam_from_bone);
+
+  // Contacts with the object's points, and those held since the previous frame.
+  const std::vector<Eigen::Vector3f> vertices = model_.Pose(cam_from_bone).vertices;
+  if (!result.segmentation.object_points.empty() && result.HasPose()) {
+    const PointKdTree object(result.segmentation.object_points);
+    result.contacts = contacts_.Detect(vertices, object);
+    if (!previous_vertices_.empty()) {
+      for (int v : result.contacts.vertices) {
+        if (std::binary_search(previous_contact_vertices_.begin(), previous_contact_vertices_.end(),
+                               v)) {
+          result.contact_pairs.push_back(
+              {v, previous_vertices_[v].cast<double>(), vertices[v].cast<double>()});
+        }
+      }
+    }
+  }
+  previous_vertices_ = vertices;
+  previous_contact_vertices_ = result.contacts.vertices;
+  std::sort(previous_contact_vertices_.begin(), previous_contact_vertices_.end());
+  return finish();
+}
+
+}  // namespace ihs::tracker

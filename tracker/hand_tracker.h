@@ -1,0 +1,117 @@
+#pragma once
+// The hand-tracker stage: per frame, segment hand and object, fit the hand model from a
+// constant-velocity prediction, detect divergence and re-initialise without stopping, and find
+// the fingertip contacts with the object. One obvious entry point: Track(frame).
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "tracker/contacts.h"
+#include "tracker/hand_fit.h"
+#include "tracker/hand_model.h"
+#include "tracker/hand_pose.h"
+#include "tracker/segmentation.h"
+
+namespace ihs::tracker {
+
+/// Options of the hand tracker.
+struct TrackerOptions {
+  SegmentationOptions segmentation;
+  HandFitOptions fit;
+  ContactOptions contacts;
+  /// A frame needs this many hand points to be fitted; with fewer it is skipped (no hand).
+  int min_hand_points = 150;
+  /// A fit with fewer of the hand's points within 10 mm of the model than this has diverged.
+  double min_data_coverage = 0.75;
+  /// Diverged frames in a row before the tracker re-initialises from the hand cloud.
+  int diverged_frames_to_reinitialise = 2;
+  /// Levenberg–Marquardt iterations (outer) for each initialisation hypothesis.
+  int initialisation_iterations = 8;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// What happened to a frame.
+enum class TrackStatus {
+  kTracked,      ///< Fitted from the previous pose.
+  kInitialised,  ///< Fitted from scratch (first frame with a hand, or after divergence).
+  kDiverged,     ///< Fitted, but the fit does not explain the data; not to be trusted.
+  kNoHand,       ///< Skipped: too few hand points.
+  kEmptyFrame,   ///< Skipped: no depth at all.
+};
+
+/// A short name for stats and logs ("tracked", "initialised", …).
+const char* ToString(TrackStatus status);
+
+/// A contact vertex seen in contact in two consecutive frames: where the hand had it in the
+/// previous frame and where it has it now (camera frame, mm). Without slip, both are the same
+/// point of the object.
+struct ContactPair {
+  int vertex = 0;
+  Eigen::Vector3d previous_mm;
+  Eigen::Vector3d current_mm;
+};
+
+/// The tracker's result for one frame.
+struct TrackResult {
+  TrackStatus status = TrackStatus::kNoHand;
+  /// Why a frame was skipped or distrusted (empty when tracked).
+  std::string reason;
+  HandPose pose;
+  /// The 21 joints (HandModel::JointPositions), camera frame, mm.
+  std::vector<Eigen::Vector3d> joints_mm;
+  Contacts contacts;
+  std::vector<ContactPair> contact_pairs;
+  Segmentation segmentation;
+  HandFitResult fit;
+  /// Time spent on this frame, ms.
+  double milliseconds = 0;
+
+  /// Whether the pose is usable (tracked or initialised).
+  bool HasPose() const {
+    return status == TrackStatus::kTracked || status == TrackStatus::kInitialised;
+  }
+};
+
+/// Tracks one hand through a sequence of frames. Not thread-safe; one per thread.
+class HandTracker {
+ public:
+  HandTracker(HandModel model, const CameraIntrinsics& intrinsics, TrackerOptions options = {});
+  ~HandTracker();
+
+  /// Starts (or restarts) from a known pose (benchmark mode: the ground truth); otherwise the
+  /// first frame with a hand initialises from the hand cloud (the user shows an open hand).
+  void Initialise(const HandPose& pose);
+
+  /// Processes the next frame (depth in mm with registered colour).
+  TrackResult Track(const Frame& frame);
+
+  const HandModel& model() const { return model_; }
+  const TrackerOptions& options() const { return options_; }
+
+ private:
+  HandFitResult InitialiseFromCloud(const std::vector<Eigen::Vector3f>& hand_points,
+                                    const Frame& frame) const;
+
+  const HandModel model_;
+  const CameraIntrinsics intrinsics_;
+  const TrackerOptions options_;
+  Segmenter segmenter_;
+  HandFitter fitter_;
+  HandFitter initial_fitter_;
+  ContactDetector contacts_;
+  bool has_pose_ = false;
+  HandPose pose_;
+  HandPose previous_pose_;
+  bool has_previous_ = false;
+  int diverged_in_a_row_ = 0;
+  std::vector<Eigen::Vector3f> previous_vertices_;
+  std::vector<int> previous_contact_vertices_;
+};
+
+}  // namespace ihs::tracker
