@@ -1,5 +1,6 @@
 #include "tracker/hand_data.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -225,6 +226,20 @@ RecordedHand LoadRecordedHand(const fs::path& data_dir, const fs::path& sequence
   }
   model.Check();
   return hand;
+}
+
+HandModel LoadHandModel(const fs::path& data_dir) {
+  std::vector<fs::path> sessions;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(data_dir / "sequences", error)) {
+    if (fs::exists(entry.path() / "Model_Hand_R.MOTION")) sessions.push_back(entry.path());
+  }
+  if (sessions.empty()) {
+    throw InputError(data_dir.string() +
+                     ": not a hand data folder (no sequences/*/Model_Hand_R.MOTION)");
+  }
+  std::sort(sessions.begin(), sessions.end());
+  return LoadRecordedHand(data_dir, sessions.front()).model;
 }
 
 }  // namespace ihs::tracker

@@ -24,6 +24,11 @@ struct RecordedHand {
 RecordedHand LoadRecordedHand(const std::filesystem::path& data_dir,
                               const std::filesystem::path& sequence_dir);
 
+/// The hand model of a data folder alone: its skeleton and rest transforms come from the first
+/// session under `data_dir`/sequences (they are the same in every session). Throws
+/// ihs::InputError when the folder holds no session.
+HandModel LoadHandModel(const std::filesystem::path& data_dir);
+
 /// Reads an OFF triangle mesh (3-vertex faces; larger polygons are fanned).
 TriangleMesh ReadOffMesh(const std::filesystem::path& path);
 

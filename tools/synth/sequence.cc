@@ -29,21 +29,6 @@ using nlohmann::json;
 
 constexpr const char* kFingerNames[5] = {"pinky", "ring", "middle", "index", "thumb"};
 
-// The first session folder (holding Model_Hand_R.MOTION) under `data_dir`/sequences.
-fs::path FirstSession(const fs::path& data_dir) {
-  std::vector<fs::path> sessions;
-  std::error_code error;
-  for (const auto& entry : fs::directory_iterator(data_dir / "sequences", error)) {
-    if (fs::exists(entry.path() / "Model_Hand_R.MOTION")) sessions.push_back(entry.path());
-  }
-  if (sessions.empty()) {
-    throw InputError(data_dir.string() +
-                     ": not a hand data folder (no sequences/*/Model_Hand_R.MOTION)");
-  }
-  std::sort(sessions.begin(), sessions.end());
-  return sessions.front();
-}
-
 // A colour-mapped depth image (near = warm, over the frame's own depth range), black where
 // there is no depth.
 cv::Mat DepthImage(const Frame& frame) {
@@ -118,7 +103,7 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     if (options_.hand == "procedural") {
       hand_ = tracker::MakeProceduralHand();
     } else {
-      hand_ = tracker::LoadRecordedHand(options_.hand, FirstSession(options_.hand)).model;
+      hand_ = tracker::LoadHandModel(options_.hand);
     }
     motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }
