@@ -1,6 +1,7 @@
 #include "tracker/procedural_hand.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -9,6 +10,9 @@
 
 namespace ihs::tracker {
 namespace {
+
+// How far a fingertip's skin reaches beyond its bone's end point, mm.
+constexpr double kTipBeyondEndMm = 1.7;
 
 // A bone frame at `start` whose x axis is `direction` and whose y (flexion) axis lies in the
 // palm plane, so that negative flexion bends toward the palm (+y).
@@ -196,14 +200,21 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   AppendCapsule(model, model.model_from_bone_rest[0], wrist, 28 * s, 10 * s, 0.45, segments * 2,
                 JointBlendWeights(model, 0));
   // Fingers and thumb: round capsules on the phalanges and the thumb's metacarpal.
+  // A fingertip's skin ends just beyond its bone's end point, as on a real hand (the scanned
+  // hand's end points lie 1.4–1.9 mm inside the tip): its capsule stops short by the radius.
+  const std::vector<int> ends = model.EndEffectors();
   for (int bone = 1; bone < static_cast<int>(model.bones.size()); ++bone) {
     const std::string& name = model.bones[bone].name;
     const int finger = name[6] - '0';
     const bool metacarpal = name.size() >= 4 && name.substr(name.size() - 4) == "Hand";
     if (metacarpal && finger < 4) continue;  // Inside the palm.
     const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : 1.0);
-    AppendCapsule(model, model.model_from_bone_rest[bone], model.bones[bone].length_mm, radius,
-                  radius, metacarpal ? 0.7 : 0.9, segments, JointBlendWeights(model, bone));
+    double length = model.bones[bone].length_mm;
+    if (std::find(ends.begin(), ends.end(), bone) != ends.end()) {
+      length = std::max(0.3 * length, length - radius + kTipBeyondEndMm * s);
+    }
+    AppendCapsule(model, model.model_from_bone_rest[bone], length, radius, radius,
+                  metacarpal ? 0.7 : 0.9, segments, JointBlendWeights(model, bone));
   }
   model.rest_mesh.ComputeVertexNormals();
   model.Check();

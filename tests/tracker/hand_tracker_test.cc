@@ -138,10 +138,11 @@ TEST(HandTrackerTest, TheProceduralTemplateFollowsTheRealHand) {
   }
   std::printf("procedural template: start %.2f mm, mean joint error %.2f mm over %d frames\n",
               start_error, error / renderer.frame_count(), renderer.frame_count());
-  // Measured: start 2.47 mm, 12.1 mm mean over frames 0–60 — the target is 10 mm: the
-  // template's shape and proportions differ from the real hand's and no scale is estimated yet.
+  // Measured: start 2.47 mm, 9.6 mm mean over frames 0–60 (12.3 mm over 0–149 with
+  // inhandscan-track; the target is 10 mm): the template's shape differs from the real
+  // hand's, and the fit drifts by about 10 mm over the first 60 frames.
   EXPECT_LT(start_error, 5.0);
-  EXPECT_LT(error / renderer.frame_count(), 15.0);
+  EXPECT_LT(error / renderer.frame_count(), 12.0);
 }
 
 }  // namespace
