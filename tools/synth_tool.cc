@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
   app.add_option("--object", options.object,
                  "sphere, water-bottle, bowling-pin, small-bottle, box or lathe:FILE")
       ->capture_default_str();
+  app.add_flag("--textured", options.textured,
+               "give a lathe object a checkerboard (default: one uniform colour)");
   app.add_option("--motion", options.motion,
                  "scripted, or recorded:DIR (a session folder of the real hand data)")
       ->capture_default_str();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "core/errors.h"
 #include "tests/test_util.h"
@@ -39,6 +40,22 @@ TEST(ObjectShapeTest, SignedDistanceOfTheSphereAndTheBox) {
   EXPECT_NEAR(bottle.SignedDistance({0, 0, 230}), 12, 1e-9);     // Above the cap.
   EXPECT_NEAR(bottle.RadiusAt(100), 36.5, 1e-9);
   EXPECT_THROW(ObjectShape::FromSpec("teapot"), std::invalid_argument);
+}
+
+TEST(ObjectShapeTest, ATexturedLatheObjectHasTheSameShapeInTwoColours) {
+  const std::array<std::uint8_t, 3> blue = {70, 110, 200};
+  const ObjectShape plain = ObjectShape::FromSpec("small-bottle", false, blue);
+  const ObjectShape textured = ObjectShape::FromSpec("small-bottle", true, blue);
+  EXPECT_FALSE(plain.textured());
+  EXPECT_TRUE(textured.textured());
+  EXPECT_TRUE(textured.mesh().IsWatertight());
+  EXPECT_NEAR(textured.mesh().Volume(), plain.mesh().Volume(), 1e-3 * plain.mesh().Volume());
+  std::set<std::array<std::uint8_t, 3>> colours(textured.mesh().colors.begin(),
+                                                textured.mesh().colors.end());
+  EXPECT_EQ(colours.size(), 2u);
+  EXPECT_TRUE(colours.count(blue));
+  for (const auto& v : textured.mesh().vertices)
+    ASSERT_NEAR(textured.SignedDistance(v.cast<double>()), 0, 1e-3);
 }
 
 // Angle (rad) of the rotation b·a⁻¹ about the object's own axis, signed.

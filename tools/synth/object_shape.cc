@@ -20,12 +20,13 @@ double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
 
 }  // namespace
 
-ObjectShape ObjectShape::FromSpec(const std::string& spec) {
+ObjectShape ObjectShape::FromSpec(const std::string& spec, bool textured,
+                                  std::array<std::uint8_t, 3> rgb) {
   if (spec == "box") return Box("box", Eigen::Vector3d(60, 45, 90));
   if (spec.rfind("lathe:", 0) == 0) {
     const std::string file = spec.substr(6);
     if (file.empty()) throw std::invalid_argument("--object lathe:FILE needs a file name");
-    return Lathe(spec, ReadLatheProfile(file));
+    return Lathe(spec, ReadLatheProfile(file), rgb, textured);
   }
   const auto names = PaperObjectNames();
   if (std::find(names.begin(), names.end(), spec) == names.end()) {
@@ -33,14 +34,41 @@ ObjectShape ObjectShape::FromSpec(const std::string& spec) {
                                 "' (sphere, water-bottle, bowling-pin, small-bottle, box, "
                                 "lathe:FILE)");
   }
-  return Lathe(spec, PaperObjectProfile(spec));
+  return Lathe(spec, PaperObjectProfile(spec), rgb, textured);
 }
 
 ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& profile,
-                               std::array<std::uint8_t, 3> rgb) {
+                               std::array<std::uint8_t, 3> rgb, bool textured) {
   ObjectShape shape;
   shape.name_ = name;
-  shape.mesh_ = MakeLatheMesh(profile, kLatheSegments, rgb);
+  shape.textured_ = textured;
+  if (!textured) {
+    shape.mesh_ = MakeLatheMesh(profile, kLatheSegments, rgb);
+  } else {
+    // A profile sampled every 2 mm, so the pattern's edges stay sharp, then a checkerboard.
+    LatheProfile dense;
+    for (size_t i = 0; i + 1 < profile.size(); ++i) {
+      const auto [z0, r0] = profile[i];
+      const auto [z1, r1] = profile[i + 1];
+      const int steps =
+          std::max(1, static_cast<int>(std::ceil(std::hypot(z1 - z0, r1 - r0) / 2.0)));
+      for (int k = 0; k < steps; ++k) {
+        dense.emplace_back(z0 + (z1 - z0) * k / steps, r0 + (r1 - r0) * k / steps);
+      }
+    }
+    dense.push_back(profile.back());
+    shape.mesh_ = MakeLatheMesh(dense, kLatheSegments, rgb);
+    for (size_t v = 0; v < shape.mesh_.vertices.size(); ++v) {
+      const Eigen::Vector3f& p = shape.mesh_.vertices[v];
+      const double phi = std::atan2(p.y(), p.x()) + M_PI;
+      const int sector = static_cast<int>(phi / (2 * M_PI) * 12) % 12;
+      const int band = static_cast<int>(std::floor(p.z() / 12.0));
+      if ((sector + band) % 2 == 0) {
+        for (int c = 0; c < 3; ++c)
+          shape.mesh_.colors[v][c] = static_cast<std::uint8_t>(rgb[c] / 3);
+      }
+    }
+  }
   shape.height_mm_ = profile.back().first - profile.front().first;
   // The outline runs up the axis side closed by the end discs: (0, z0) … profile … (0, zn).
   shape.outline_.emplace_back(0.0, profile.front().first);

@@ -17,10 +17,14 @@ class ObjectShape {
   /// "sphere", "water-bottle", "bowling-pin", "small-bottle" (the paper's objects), "box" (a
   /// textured 60 × 45 × 90 mm box) or "lathe:FILE" (a profile file of "height radius" lines).
   /// Throws std::invalid_argument for an unknown name and ihs::InputError for a bad file.
-  static ObjectShape FromSpec(const std::string& spec);
-  /// A surface of revolution about +z, uniform colour `rgb`.
+  /// `textured`: lathe objects get a colour pattern in `rgb` too (the box always has its own).
+  static ObjectShape FromSpec(const std::string& spec, bool textured = false,
+                              std::array<std::uint8_t, 3> rgb = {235, 235, 235});
+  /// A surface of revolution about +z, uniform colour `rgb`; textured: a checkerboard of 12
+  /// sectors around and 12 mm bands along the axis in `rgb` and a darker shade of it.
   static ObjectShape Lathe(const std::string& name, const LatheProfile& profile,
-                           std::array<std::uint8_t, 3> rgb = {235, 235, 235});
+                           std::array<std::uint8_t, 3> rgb = {235, 235, 235},
+                           bool textured = false);
   /// A textured box of `size` (x, y, z) mm standing on z = 0, centred on the axis.
   static ObjectShape Box(const std::string& name, const Eigen::Vector3d& size);
 

@@ -88,7 +88,9 @@ void SequenceOptions::Check() const {
 }
 
 SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
-    : options_(options), object_(ObjectShape::FromSpec((options.Check(), options.object))) {
+    : options_(options),
+      object_(ObjectShape::FromSpec((options.Check(), options.object), options.textured,
+                                    options.object_rgb)) {
   const bool recorded = options_.motion != "scripted";
   if (recorded) {
     const fs::path session = options_.motion.substr(9);

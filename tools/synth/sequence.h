@@ -36,6 +36,8 @@ namespace ihs::synth {
 struct SequenceOptions {
   /// ObjectShape::FromSpec name: sphere, water-bottle, bowling-pin, small-bottle, box, lathe:FILE.
   std::string object = "sphere";
+  /// Give a lathe object a colour pattern (a checkerboard); by default it is one uniform colour.
+  bool textured = false;
   /// "scripted", or "recorded:DIR" with DIR a session folder of the real hand data (holding
   /// Model_Hand_R.SKEL and .MOTION).
   std::string motion = "scripted";
