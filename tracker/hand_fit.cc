@@ -276,6 +276,11 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     std::fill(visible.begin(), visible.end(), false);
     for (int i : facing) {
       if (cell[i] < 0 || posed[i].z() > nearest[cell[i]] + 8.0f) continue;
+      const Eigen::Vector3d p = posed[i].cast<double>();
+      if ((p.array() < options_.crop_min_mm.array()).any() ||
+          (p.array() > options_.crop_max_mm.array()).any()) {
+        continue;
+      }
       if (frame) {
         const int u = static_cast<int>(std::lround(pixel[i].x()));
         const int v = static_cast<int>(std::lround(pixel[i].y()));

@@ -37,6 +37,11 @@ struct HandFitOptions {
   double prior_weight = 1.5;
   /// Initial Levenberg–Marquardt trust region: correspondences hold only near the current pose.
   double initial_trust_radius = 10.0;
+  /// The volume the hand points were cropped to (camera frame, mm): model points outside it
+  /// have no data to match and are not pulled toward any. Unbounded by default; the tracker
+  /// sets it to the segmentation's crop volume.
+  Eigen::Vector3d crop_min_mm = Eigen::Vector3d::Constant(-1e9);
+  Eigen::Vector3d crop_max_mm = Eigen::Vector3d::Constant(1e9);
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

@@ -55,8 +55,16 @@ void TrackerOptions::Check() const {
 }
 
 namespace {
-HandFitOptions InitialFitOptions(const TrackerOptions& options) {
+// The fit's options with the segmentation's crop volume.
+HandFitOptions FitOptions(const TrackerOptions& options) {
   HandFitOptions fit = options.fit;
+  fit.crop_min_mm = options.segmentation.crop_min_mm;
+  fit.crop_max_mm = options.segmentation.crop_max_mm;
+  return fit;
+}
+
+HandFitOptions InitialFitOptions(const TrackerOptions& options) {
+  HandFitOptions fit = FitOptions(options);
   fit.outer_iterations = options.initialisation_iterations;
   fit.prior_weight = 0.5;
   return fit;
@@ -69,7 +77,7 @@ HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
       intrinsics_(intrinsics),
       options_((options.Check(), std::move(options))),
       segmenter_(intrinsics, options_.segmentation),
-      fitter_(model_, intrinsics, options_.fit),
+      fitter_(model_, intrinsics, FitOptions(options_)),
       initial_fitter_(model_, intrinsics, InitialFitOptions(options_)),
       contacts_(model_, options_.contacts) {}
 

@@ -204,8 +204,9 @@ TEST(HandFitterTest, TracksTheScriptedMotionCoarsely) {
   options.object = "sphere";
   options.scripted.frames = 240;
   options.last_frame = 79;
-  // Measured 15.8 mm mean over 240 frames: the hand holds the object from behind, mostly hidden,
-  // and its wrist drifts. A regression guard until the tracker issue's recovery lands.
+  // Measured 7.8 mm mean over these 80 frames (15.8 mm over 240 before model points outside the
+  // crop volume stopped being matched): the hand holds the object from behind, mostly hidden,
+  // and its wrist drifts. A regression guard while the tracker is made robust.
   EXPECT_LT(TrackFromTheFirstPose(options), 25.0);
 }
 
