@@ -14,10 +14,11 @@ echo "demo:   $sample/contact_sheet.png)"
 
 if [[ ! -x "$build_dir/app/inhandscan" ]]; then
   cat <<MSG
-demo: the scanning application (app/inhandscan) does not exist yet: the tracker, fusion and
-demo: application stages are still being built, so there is no mesh to show. What is built so far
+demo: the scanning application (app/inhandscan) does not exist yet: fusion and the application
+demo: are still being built, so there is no mesh to show. What is built so far
 demo: (in $build_dir):
 demo:   tools/inhandscan-synth  render ground-truthed synthetic scanning sequences
+demo:   tools/inhandscan-track  track the hand (joints, fingertip contacts) through a recording
 demo:   tools/inhandscan-frames inspect and convert recordings (.oni, TUM RGB-D folders)
 demo:   tools/inhandscan-mesh   inspect and convert meshes (PLY, OBJ, STL)
 MSG
