@@ -68,6 +68,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   nlohmann::json frames = nlohmann::json::array();
   std::map<std::string, int> counts;
   std::vector<double> joint_errors, contact_errors, milliseconds;
+  double stage_ms[3] = {0, 0, 0};
   std::int64_t index = 0;
   while (true) {
     const ihs::sensor::SourceRead read = source->Next(std::chrono::seconds(5));
@@ -83,7 +84,12 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
     milliseconds.push_back(result.milliseconds);
     nlohmann::json entry = {{"frame", index},
                             {"status", ihs::tracker::ToString(result.status)},
-                            {"ms", result.milliseconds}};
+                            {"ms", result.milliseconds},
+                            {"segmentation_ms", result.segmentation_ms},
+                            {"fit_ms", result.fit_ms},
+                            {"contacts_ms", result.contacts_ms}};
+    stage_ms[0] += result.segmentation_ms, stage_ms[1] += result.fit_ms,
+        stage_ms[2] += result.contacts_ms;
     if (!result.reason.empty()) entry["reason"] = result.reason;
     if (!result.joints_mm.empty()) {
       entry["data_coverage"] = result.fit.data_coverage;
@@ -128,7 +134,10 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   nlohmann::json summary = {{"frames", index},
                             {"status_counts", counts},
                             {"ms_mean", total_ms / index},
-                            {"ms_p95", Quantile(milliseconds, 0.95)}};
+                            {"ms_p95", Quantile(milliseconds, 0.95)},
+                            {"segmentation_ms_mean", stage_ms[0] / index},
+                            {"fit_ms_mean", stage_ms[1] / index},
+                            {"contacts_ms_mean", stage_ms[2] / index}};
   if (!joint_errors.empty()) {
     double sum = 0;
     for (double e : joint_errors) sum += e;
@@ -144,8 +153,11 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   std::printf("frames %lld: tracked %d, initialised %d, diverged %d, no hand %d, empty %d\n",
               static_cast<long long>(index), counts["tracked"], counts["initialised"],
               counts["diverged"], counts["no_hand"], counts["empty_frame"]);
-  std::printf("time per frame: %.1f ms mean, %.1f ms p95 (one core)\n", total_ms / index,
-              Quantile(milliseconds, 0.95));
+  std::printf(
+      "time per frame: %.1f ms mean, %.1f ms p95 (one core); segmentation %.1f, fit %.1f, "
+      "contacts %.1f ms\n",
+      total_ms / index, Quantile(milliseconds, 0.95), stage_ms[0] / index, stage_ms[1] / index,
+      stage_ms[2] / index);
   if (!joint_errors.empty()) {
     std::printf("joint error: %.2f mm mean, %.2f mm p95 over %zu frames\n",
                 summary["joint_error_mm_mean"].get<double>(), Quantile(joint_errors, 0.95),

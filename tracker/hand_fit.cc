@@ -13,6 +13,8 @@ namespace ihs::tracker {
 namespace {
 
 constexpr double kCoverageMm = 10.0;
+// Model vertices used for correspondences, at most (an even subsample).
+constexpr size_t kModelSamples = 1500;
 // Collision pairs are kept when their capsules are closer than this beyond touching, mm.
 constexpr double kCollisionMarginMm = 5.0;
 // A model point counts as hidden when the depth image sees something this much nearer, mm.
@@ -170,7 +172,7 @@ HandFitter::HandFitter(const HandModel& model, const CameraIntrinsics& intrinsic
   options_.Check();
   model_.Check();
   const size_t vertices = model.rest_mesh.vertices.size();
-  const size_t stride = std::max<size_t>(1, vertices / 3000);
+  const size_t stride = std::max<size_t>(1, vertices / kModelSamples);
   std::vector<int> dominant(vertices, 0);
   for (size_t v = 0; v < vertices; ++v) {
     float best = -1;

@@ -140,7 +140,13 @@ TrackResult HandTracker::Track(const Frame& frame) {
     has_previous_ = false;
     return finish();
   }
+  auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  auto stage = std::chrono::steady_clock::now();
   result.segmentation = segmenter_.Segment(frame);
+  result.segmentation_ms = since(stage);
+  stage = std::chrono::steady_clock::now();
   const auto& points = result.segmentation.hand_points;
   if (static_cast<int>(points.size()) < options_.min_hand_points) {
     result.status = TrackStatus::kNoHand;
@@ -181,6 +187,8 @@ TrackResult HandTracker::Track(const Frame& frame) {
     diverged_in_a_row_ = 0;
   }
 
+  result.fit_ms = since(stage);
+  stage = std::chrono::steady_clock::now();
   previous_pose_ = pose_;
   has_previous_ = has_pose_ && result.status == TrackStatus::kTracked;
   pose_ = result.fit.pose;
@@ -204,6 +212,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
       }
     }
   }
+  result.contacts_ms = since(stage);
   previous_vertices_ = vertices;
   previous_contact_vertices_ = result.contacts.vertices;
   std::sort(previous_contact_vertices_.begin(), previous_contact_vertices_.end());

@@ -69,8 +69,12 @@ struct TrackResult {
   std::vector<ContactPair> contact_pairs;
   Segmentation segmentation;
   HandFitResult fit;
-  /// Time spent on this frame, ms.
+  /// Time spent on this frame, ms: in all, and on segmentation, the pose fit (with any
+  /// re-initialisation) and the contacts.
   double milliseconds = 0;
+  double segmentation_ms = 0;
+  double fit_ms = 0;
+  double contacts_ms = 0;
 
   /// Whether the pose is usable (tracked or initialised).
   bool HasPose() const {
