@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -14,7 +15,7 @@ namespace {
 
 constexpr double kCoverageMm = 10.0;
 // Model vertices used for correspondences, at most (an even subsample).
-constexpr size_t kModelSamples = 1500;
+constexpr size_t kModelSamples = 5000;
 // Collision pairs are kept when their capsules are closer than this beyond touching, mm.
 constexpr double kCollisionMarginMm = 5.0;
 // A model point counts as hidden when the depth image sees something this much nearer, mm.
@@ -41,17 +42,53 @@ void ClosestPointsOfSegments(const Eigen::Vector3d& p0, const Eigen::Vector3d& p
   }
 }
 
+// For each pixel of `roi` (x0, y0, x1, y1; exclusive ends) of a width-wide mask, the index of an
+// (approximately) nearest set pixel, or −1: nearest sites propagated in two raster passes.
+std::vector<int> NearestSetPixels(const std::vector<std::uint8_t>& mask, int width,
+                                  const std::array<int, 4>& roi) {
+  const auto [x0, y0, x1, y1] = roi;
+  const int w = x1 - x0, h = y1 - y0;
+  std::vector<int> site(static_cast<size_t>(w) * h, -1);
+  std::vector<double> distance(site.size(), std::numeric_limits<double>::infinity());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int pixel = (y + y0) * width + x + x0;
+      if (mask[pixel]) site[y * w + x] = pixel, distance[y * w + x] = 0;
+    }
+  }
+  auto relax = [&](int x, int y, int nx, int ny) {
+    if (nx < 0 || ny < 0 || nx >= w || ny >= h) return;
+    const int candidate = site[ny * w + nx];
+    if (candidate < 0) return;
+    const double dx = candidate % width - (x + x0), dy = candidate / width - (y + y0);
+    const double d = dx * dx + dy * dy;
+    if (d < distance[y * w + x]) distance[y * w + x] = d, site[y * w + x] = candidate;
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      relax(x, y, x - 1, y), relax(x, y, x - 1, y - 1), relax(x, y, x, y - 1);
+      relax(x, y, x + 1, y - 1);
+    }
+  }
+  for (int y = h - 1; y >= 0; --y) {
+    for (int x = w - 1; x >= 0; --x) {
+      relax(x, y, x + 1, y), relax(x, y, x + 1, y + 1), relax(x, y, x, y + 1);
+      relax(x, y, x - 1, y + 1);
+    }
+  }
+  return site;
+}
+
 }  // namespace
 
 HandFitCost::HandFitCost(const HandModel& model, const Eigen::Matrix3d& reference_rotation,
-                         std::vector<PointPair> pairs, std::vector<PlanePair> planes,
-                         std::vector<CollisionPair> collisions, double collision_weight,
-                         double limit_weight, double prior_weight, std::vector<double> prior_rad)
+                         const CameraIntrinsics& intrinsics, HandFitTerms terms,
+                         double collision_weight, double limit_weight, double prior_weight,
+                         std::vector<double> prior_rad)
     : model_(model),
       reference_(reference_rotation),
-      pairs_(std::move(pairs)),
-      planes_(std::move(planes)),
-      collisions_(std::move(collisions)),
+      intrinsics_(intrinsics),
+      terms_(std::move(terms)),
       collision_sqrt_(std::sqrt(collision_weight)),
       limit_weight_(limit_weight),
       prior_weight_(prior_weight),
@@ -61,8 +98,9 @@ HandFitCost::HandFitCost(const HandModel& model, const Eigen::Matrix3d& referenc
   IHS_CHECK(prior_.size() == dofs_.size(),
             "prior has " << prior_.size() << " angles, the model " << dofs_.size());
   const int n = derivatives_.size();
-  set_num_residuals(
-      static_cast<int>(3 * pairs_.size() + planes_.size() + collisions_.size() + 2 * dofs_.size()));
+  set_num_residuals(static_cast<int>(3 * terms_.points.size() + terms_.planes.size() +
+                                     2 * terms_.silhouette.size() + terms_.collisions.size() +
+                                     2 * dofs_.size()));
   mutable_parameter_block_sizes()->push_back(n);
 }
 
@@ -75,10 +113,12 @@ bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
   if (jacobian) std::fill(jacobian, jacobian + static_cast<size_t>(num_residuals()) * n, 0.0);
   int row = 0;
   std::vector<double> point_jacobian(3 * n);
-  for (const PointPair& pair : pairs_) {
-    const Eigen::Vector3d p = derivatives_.SkinnedPoint(model_.weights[pair.vertex],
-                                                        model_.rest_mesh.vertices[pair.vertex],
-                                                        jacobian ? point_jacobian.data() : nullptr);
+  auto skinned = [&](int vertex) {
+    return derivatives_.SkinnedPoint(model_.weights[vertex], model_.rest_mesh.vertices[vertex],
+                                     jacobian ? point_jacobian.data() : nullptr);
+  };
+  for (const PointPair& pair : terms_.points) {
+    const Eigen::Vector3d p = skinned(pair.vertex);
     for (int r = 0; r < 3; ++r) {
       residuals[row + r] = pair.weight * (p[r] - pair.target[r]);
       if (jacobian) {
@@ -88,10 +128,8 @@ bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
     }
     row += 3;
   }
-  for (const PlanePair& pair : planes_) {
-    const Eigen::Vector3d p = derivatives_.SkinnedPoint(model_.weights[pair.vertex],
-                                                        model_.rest_mesh.vertices[pair.vertex],
-                                                        jacobian ? point_jacobian.data() : nullptr);
+  for (const PlanePair& pair : terms_.planes) {
+    const Eigen::Vector3d p = skinned(pair.vertex);
     residuals[row] = pair.weight * pair.normal.dot(p - pair.target);
     if (jacobian) {
       for (int c = 0; c < n; ++c) {
@@ -102,8 +140,25 @@ bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
     }
     ++row;
   }
+  for (const SilhouettePair& pair : terms_.silhouette) {
+    const Eigen::Vector3d p = skinned(pair.vertex);
+    const double z = std::max(p.z(), 1.0), focal[2] = {intrinsics_.fx, intrinsics_.fy};
+    const Eigen::Vector2d pixel = intrinsics_.Project(Eigen::Vector3d(p.x(), p.y(), z));
+    for (int r = 0; r < 2; ++r) {
+      residuals[row + r] = pair.weight * (pixel[r] - pair.target[r]);
+      if (jacobian) {
+        // d(f·p_r/z + c) = f/z·dp_r − f·p_r/z²·dz.
+        for (int c = 0; c < n; ++c) {
+          jacobian[(row + r) * n + c] =
+              pair.weight * focal[r] / z *
+              (point_jacobian[r * n + c] - p[r] / z * point_jacobian[2 * n + c]);
+        }
+      }
+    }
+    row += 2;
+  }
   std::vector<double> jacobian_b(3 * n);
-  for (const CollisionPair& pair : collisions_) {
+  for (const CollisionPair& pair : terms_.collisions) {
     const Eigen::Vector3d a = derivatives_.BonePoint(pair.bone_a, pair.point_a,
                                                      jacobian ? point_jacobian.data() : nullptr);
     const Eigen::Vector3d b =
@@ -147,6 +202,9 @@ void HandFitOptions::Check() const {
   IHS_CHECK_ARG(limit_weight >= 0 && prior_weight >= 0,
                 "hand_fit.limit_weight and prior_weight must be >= 0");
   IHS_CHECK_ARG(initial_trust_radius > 0, "hand_fit.initial_trust_radius must be positive");
+  IHS_CHECK_ARG(data_point_weight >= 0, "hand_fit.data_point_weight must be >= 0");
+  IHS_CHECK_ARG(silhouette_weight >= 0 && silhouette_tolerance_px >= 0,
+                "hand_fit.silhouette_weight and silhouette_tolerance_px must be >= 0");
 }
 
 // Precomputed per model: sample vertices and collision capsules.
@@ -217,7 +275,7 @@ HandFitter::HandFitter(const HandModel& model, const CameraIntrinsics& intrinsic
 HandFitter::~HandFitter() = default;
 
 HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
-                              const HandPose& initial) const {
+                              const HandPose& initial, const Segmentation* segmentation) const {
   HandFitResult result;
   result.pose = initial;
   if (hand_points.empty()) return result;
@@ -302,6 +360,69 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
                                                 : std::sqrt(options_.robust_scale_mm / distance);
   };
 
+  // The silhouette (hand and object pixels) and, around the model's image, each pixel's
+  // nearest silhouette pixel.
+  const bool use_silhouette = segmentation != nullptr && options_.silhouette_weight > 0 &&
+                              segmentation->width > 0 &&
+                              segmentation->hand_mask.size() == segmentation->object_mask.size();
+  std::vector<std::uint8_t> silhouette;
+  std::vector<int> nearest_silhouette;
+  std::array<int, 4> roi = {0, 0, 0, 0};
+  if (use_silhouette) {
+    silhouette.resize(segmentation->hand_mask.size());
+    for (size_t p = 0; p < silhouette.size(); ++p)
+      silhouette[p] = segmentation->hand_mask[p] | segmentation->object_mask[p];
+    pose_samples(pose);
+    constexpr int kMarginPx = 40;
+    roi = {segmentation->width, segmentation->height, 0, 0};
+    for (const Eigen::Vector3f& p : posed) {
+      if (p.z() <= 1) continue;
+      const Eigen::Vector2d pixel = intrinsics_.Project(p.cast<double>());
+      roi[0] = std::min(roi[0], static_cast<int>(pixel.x()) - kMarginPx);
+      roi[1] = std::min(roi[1], static_cast<int>(pixel.y()) - kMarginPx);
+      roi[2] = std::max(roi[2], static_cast<int>(pixel.x()) + kMarginPx);
+      roi[3] = std::max(roi[3], static_cast<int>(pixel.y()) + kMarginPx);
+    }
+    roi = {std::max(0, roi[0]), std::max(0, roi[1]), std::min(segmentation->width, roi[2]),
+           std::min(segmentation->height, roi[3])};
+    if (roi[2] > roi[0] && roi[3] > roi[1])
+      nearest_silhouette = NearestSetPixels(silhouette, segmentation->width, roi);
+  }
+  // Silhouette pairs: model points (seen or not) in the crop volume whose image lies outside
+  // the silhouette, pulled to within the tolerance of its nearest pixel. The wrist's points are
+  // left out: where a scan of the forearm ends (sleeve, crop) says nothing about the hand.
+  auto silhouette_pairs = [&]() {
+    std::vector<SilhouettePair> pairs;
+    if (nearest_silhouette.empty()) return pairs;
+    int considered = 0;
+    const int roi_width = roi[2] - roi[0];
+    for (int i = 0; i < samples; ++i) {
+      if (data_->sample_bone[i] == 0) continue;
+      const Eigen::Vector3d p = posed[i].cast<double>();
+      if (p.z() <= 1 || (p.array() < options_.crop_min_mm.array()).any() ||
+          (p.array() > options_.crop_max_mm.array()).any()) {
+        continue;
+      }
+      ++considered;
+      const Eigen::Vector2d pixel = intrinsics_.Project(p);
+      const int u = static_cast<int>(std::lround(pixel.x()));
+      const int v = static_cast<int>(std::lround(pixel.y()));
+      if (u < roi[0] || v < roi[1] || u >= roi[2] || v >= roi[3]) continue;
+      const int site = nearest_silhouette[(v - roi[1]) * roi_width + (u - roi[0])];
+      if (site < 0 || silhouette[site] == 0) continue;
+      const Eigen::Vector2d target(site % segmentation->width, site / segmentation->width);
+      const double distance = (pixel - target).norm();
+      if (distance <= options_.silhouette_tolerance_px) continue;
+      const Eigen::Vector2d inside =
+          target + options_.silhouette_tolerance_px * (pixel - target) / distance;
+      pairs.push_back({data_->samples[i], inside, p.z() / intrinsics_.fx});
+    }
+    const double scale =
+        considered == 0 ? 0 : options_.silhouette_weight / std::sqrt(double(considered));
+    for (SilhouettePair& pair : pairs) pair.weight *= scale;
+    return pairs;
+  };
+
   std::vector<int> visible_samples;
   for (int outer = 0; outer < options_.outer_iterations; ++outer) {
     pose_samples(pose);
@@ -340,6 +461,13 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     for (PointPair& pair : model_pairs) pair.weight *= model_scale;
     const double data_scale = data_pairs.empty() ? 0 : 1.0 / std::sqrt(double(data_pairs.size()));
     for (PlanePair& pair : data_pairs) pair.weight *= data_scale;
+    // The data → model pairs also as points: a plane lets a finger slide along its axis.
+    if (options_.data_point_weight > 0) {
+      for (const PlanePair& pair : data_pairs) {
+        model_pairs.push_back(
+            {pair.vertex, pair.target, options_.data_point_weight * pair.weight});
+      }
+    }
 
     // Collisions between capsules of different fingers that are close now.
     std::vector<CollisionPair> collisions;
@@ -362,12 +490,15 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     PoseParameters parameters(pose);
     ceres::Problem problem;
     problem.AddResidualBlock(
-        new HandFitCost(model_, parameters.reference_rotation(), std::move(model_pairs),
-                        std::move(data_pairs), std::move(collisions), options_.collision_weight,
-                        options_.limit_weight, options_.prior_weight, prior),
+        new HandFitCost(model_, parameters.reference_rotation(), intrinsics_,
+                        {std::move(model_pairs), std::move(data_pairs), silhouette_pairs(),
+                         std::move(collisions)},
+                        options_.collision_weight, options_.limit_weight, options_.prior_weight,
+                        prior),
         nullptr, parameters.values().data());
     ceres::Solver::Options solver;
-    solver.linear_solver_type = ceres::DENSE_QR;
+    // A few hundred residual rows, ≈ 30 parameters: the normal equations are small and cheap.
+    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
     solver.max_num_iterations = options_.inner_iterations;
     // Correspondences hold only near the current pose: start with modest steps.
     solver.initial_trust_region_radius = options_.initial_trust_radius;

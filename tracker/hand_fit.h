@@ -12,6 +12,7 @@
 #include "core/frame.h"
 #include "tracker/hand_model.h"
 #include "tracker/hand_pose.h"
+#include "tracker/segmentation.h"
 
 namespace ihs::tracker {
 
@@ -35,6 +36,15 @@ struct HandFitOptions {
   /// (predicted) joint angles (per rad), which keeps unseen fingers where they were.
   double limit_weight = 30.0;
   double prior_weight = 1.5;
+  /// Weight of data → model pairs taken point to point, besides point to plane (relative to
+  /// that): the planes of a finger's side let it slide along its axis, which a template of other
+  /// proportions than the user's hand then does frame after frame.
+  double data_point_weight = 2.0;
+  /// Weight of the silhouette term: model points whose image falls outside the observed hand
+  /// and object pixels are pulled back into them (in mm at the point's depth, as a mean over the
+  /// model's points, like the other terms). Pixels this close to the silhouette count as inside.
+  double silhouette_weight = 1.0;
+  double silhouette_tolerance_px = 2.0;
   /// Initial Levenberg–Marquardt trust region: correspondences hold only near the current pose.
   double initial_trust_radius = 10.0;
   /// The volume the hand points were cropped to (camera frame, mm): model points outside it
@@ -70,10 +80,11 @@ class HandFitter {
 
   /// Fits from `initial` (e.g. the previous pose, or a prediction) to `hand_points` (camera
   /// frame, mm). `frame` (optional) is the depth image they came from: model points hidden
-  /// behind nearer surfaces (the object) are then not matched. With no points the initial pose
-  /// comes back with zero coverage.
+  /// behind nearer surfaces (the object) are then not matched. `segmentation` (optional, of
+  /// that frame) gives the silhouette the model must stay within. With no points the initial
+  /// pose comes back with zero coverage.
   HandFitResult Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
-                    const HandPose& initial) const;
+                    const HandPose& initial, const Segmentation* segmentation = nullptr) const;
 
   const HandFitOptions& options() const { return options_; }
 

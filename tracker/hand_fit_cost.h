@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "core/camera_intrinsics.h"
 #include "tracker/hand_kinematics.h"
 #include "tracker/hand_model.h"
 
@@ -28,6 +29,14 @@ struct PlanePair {
   double weight = 1.0;
 };
 
+/// A model vertex whose image should lie at pixel `target` (the nearest pixel of the observed
+/// silhouette), weighted per pixel (the weight carries the mm per pixel at the vertex's depth).
+struct SilhouettePair {
+  int vertex = 0;
+  Eigen::Vector2d target;
+  double weight = 1.0;
+};
+
 /// Two capsules (points on their axes fixed in their bones' frames) that must stay apart by the
 /// sum of their radii.
 struct CollisionPair {
@@ -39,16 +48,24 @@ struct CollisionPair {
   double radius_b = 0;
 };
 
+/// The terms of one inner problem.
+struct HandFitTerms {
+  std::vector<PointPair> points;
+  std::vector<PlanePair> planes;
+  std::vector<SilhouettePair> silhouette;
+  std::vector<CollisionPair> collisions;
+};
+
 /// Residuals: for each point pair w·(x_v − target) (3), for each plane pair w·n·(x_v − target),
-/// for each collision √γc·max(0, r_a + r_b −
-/// |A − B|), for each joint angle the soft limit excess (limit_weight per rad) and the pull
-/// toward `prior_rad` (prior_weight per rad). One parameter block: the PoseParameters vector.
+/// for each silhouette pair w·(π(x_v) − target) (2, π the camera's projection), for each
+/// collision √γc·max(0, r_a + r_b − |A − B|), for each joint angle the soft limit excess
+/// (limit_weight per rad) and the pull toward `prior_rad` (prior_weight per rad). One parameter
+/// block: the PoseParameters vector.
 class HandFitCost : public ceres::CostFunction {
  public:
   HandFitCost(const HandModel& model, const Eigen::Matrix3d& reference_rotation,
-              std::vector<PointPair> pairs, std::vector<PlanePair> planes,
-              std::vector<CollisionPair> collisions, double collision_weight, double limit_weight,
-              double prior_weight, std::vector<double> prior_rad);
+              const CameraIntrinsics& intrinsics, HandFitTerms terms, double collision_weight,
+              double limit_weight, double prior_weight, std::vector<double> prior_rad);
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
@@ -56,9 +73,8 @@ class HandFitCost : public ceres::CostFunction {
  private:
   const HandModel& model_;
   const Eigen::Matrix3d reference_;
-  const std::vector<PointPair> pairs_;
-  const std::vector<PlanePair> planes_;
-  const std::vector<CollisionPair> collisions_;
+  const CameraIntrinsics intrinsics_;
+  const HandFitTerms terms_;
   const double collision_sqrt_;
   const double limit_weight_;
   const double prior_weight_;

@@ -167,7 +167,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
       predicted.cam_from_root =
           pose_.cam_from_root * previous_pose_.cam_from_root.Inverse() * pose_.cam_from_root;
     }
-    result.fit = fitter_.Fit(points, &frame, predicted);
+    result.fit = fitter_.Fit(points, &frame, predicted, &result.segmentation);
     result.status = TrackStatus::kTracked;
   }
   if (result.fit.data_coverage < options_.min_data_coverage) {

@@ -52,24 +52,38 @@ WeightFunction JointBlendWeights(const HandModel& model, int bone) {
   };
 }
 
+// The shape of a capsule's cross-section: `flatten` scales its z extent; `roundness` 2 is an
+// ellipse, larger values a superellipse (a rounded rectangle, like a palm's section).
+// `taper` is the radius at the capsule's end relative to its start.
+struct Section {
+  double flatten = 1.0;
+  double roundness = 2.0;
+  double taper = 1.0;
+};
+
 // Appends a closed capsule along the x axis of `model_from_capsule`: a body of `length` and
-// `radius` (flattened along z by `flatten`) with half-ellipsoid caps reaching `cap` beyond
-// each end, skinned by `weights_of`.
+// `radius` (cross-section `section`) with half-ellipsoid caps reaching `cap` beyond each end,
+// skinned by `weights_of`.
 void AppendCapsule(HandModel& model, const Rigid3& model_from_capsule, double length, double radius,
-                   double cap, double flatten, int segments, const WeightFunction& weights_of) {
+                   double cap, Section section, int segments, const WeightFunction& weights_of) {
   TriangleMesh& mesh = model.rest_mesh;
   // Profile along the axis: (x, ring radius) from pole to pole.
   std::vector<std::pair<double, double>> profile;
   const int cap_rings = 4;
+  const double end_radius = radius * section.taper;
   for (int i = 1; i <= cap_rings; ++i) {
     const double a = M_PI / 2 * i / cap_rings;  // From the start pole to the equator.
     profile.emplace_back(-cap * std::cos(a), radius * std::sin(a));
   }
-  const int body_rings = std::max(2, static_cast<int>(std::ceil(length / (radius * 0.8))));
-  for (int i = 1; i < body_rings; ++i) profile.emplace_back(length * i / body_rings, radius);
+  const int body_rings =
+      std::max(2, static_cast<int>(std::ceil(length / (std::min(radius, end_radius) * 0.8))));
+  for (int i = 1; i < body_rings; ++i) {
+    const double t = static_cast<double>(i) / body_rings;
+    profile.emplace_back(length * t, radius + (end_radius - radius) * t);
+  }
   for (int i = 0; i < cap_rings; ++i) {
     const double a = M_PI / 2 * i / cap_rings;
-    profile.emplace_back(length + cap * std::sin(a), radius * std::cos(a));
+    profile.emplace_back(length + cap * std::sin(a), end_radius * std::cos(a));
   }
   auto add = [&](const Eigen::Vector3d& in_capsule) {
     const Eigen::Vector3d in_model = model_from_capsule * in_capsule;
@@ -82,7 +96,10 @@ void AppendCapsule(HandModel& model, const Rigid3& model_from_capsule, double le
   for (const auto& [x, r] : profile) {
     for (int k = 0; k < segments; ++k) {
       const double phi = 2 * M_PI * k / segments;
-      add({x, r * std::cos(phi), flatten * r * std::sin(phi)});
+      auto power = [&](double v) {
+        return std::copysign(std::pow(std::abs(v), 2.0 / section.roundness), v);
+      };
+      add({x, r * power(std::cos(phi)), section.flatten * r * power(std::sin(phi))});
     }
   }
   const std::int32_t end_pole = add({length + cap, 0, 0});
@@ -112,6 +129,15 @@ void ProceduralHandOptions::Check() const {
     IHS_CHECK_ARG(length > 0, "hand.thumb_lengths_mm must be positive");
   for (double radius : finger_radius_mm)
     IHS_CHECK_ARG(radius > 0, "hand.finger_radius_mm must be positive");
+  IHS_CHECK_ARG(distal_taper > 0.3 && distal_taper <= 1.5,
+                "hand.distal_taper must be in (0.3, 1.5], got " << distal_taper);
+  IHS_CHECK_ARG(palm_width_mm > 0 && palm_base_width_mm > 0 && palm_thickness_mm > 0 &&
+                    palm_thickness_mm <= palm_base_width_mm,
+                "hand.palm_width_mm, palm_base_width_mm and palm_thickness_mm must be positive, "
+                "thickness <= base width");
+  IHS_CHECK_ARG(
+      wrist_width_mm > 0 && wrist_thickness_mm > 0 && wrist_thickness_mm <= wrist_width_mm,
+      "hand.wrist_width_mm and wrist_thickness_mm must be positive, thickness <= width");
   IHS_CHECK_ARG(segments >= 6 && segments <= 64,
                 "hand.segments must be in [6, 64], got " << segments);
 }
@@ -174,7 +200,7 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   // Skin. The palm: one flat capsule from the wrist to the knuckles, each point skinned to
   // the metacarpals nearest across the palm (and to the wrist near its start).
   const int segments = options.segments;
-  const double palm_length = 58 * s, palm_radius = 36 * s;
+  const double palm_length = 58 * s, palm_radius = options.palm_base_width_mm / 2 * s;
   std::array<int, 4> metacarpals;
   for (int f = 0; f < 4; ++f)
     metacarpals[f] = model.BoneIndex("RFing." + std::to_string(f) + "_Hand");
@@ -195,9 +221,13 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     return weights;
   };
   AppendCapsule(model, BoneFrame({0, 0, 8 * s}, Eigen::Vector3d::UnitZ()), palm_length, palm_radius,
-                12 * s, 0.33, segments * 2, palm_weights);
+                12 * s,
+                {options.palm_thickness_mm / options.palm_base_width_mm, 3.0,
+                 options.palm_width_mm / options.palm_base_width_mm},
+                segments * 2, palm_weights);
   // The wrist: a shorter, flat capsule on the root bone.
-  AppendCapsule(model, model.model_from_bone_rest[0], wrist, 28 * s, 10 * s, 0.45, segments * 2,
+  AppendCapsule(model, model.model_from_bone_rest[0], wrist, options.wrist_width_mm / 2 * s,
+                10 * s, {options.wrist_thickness_mm / options.wrist_width_mm, 2.0}, segments * 2,
                 JointBlendWeights(model, 0));
   // Fingers and thumb: round capsules on the phalanges and the thumb's metacarpal.
   // A fingertip's skin ends just beyond its bone's end point, as on a real hand (the scanned
@@ -208,13 +238,15 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     const int finger = name[6] - '0';
     const bool metacarpal = name.size() >= 4 && name.substr(name.size() - 4) == "Hand";
     if (metacarpal && finger < 4) continue;  // Inside the palm.
-    const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : 1.0);
+    const bool distal = std::find(ends.begin(), ends.end(), bone) != ends.end();
+    const bool proximal = model.bones[model.bones[bone].parent].name.ends_with("Hand");
+    const double taper = distal ? options.distal_taper
+                                : (proximal ? 1.0 : 0.5 * (1.0 + options.distal_taper));
+    const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : taper);
     double length = model.bones[bone].length_mm;
-    if (std::find(ends.begin(), ends.end(), bone) != ends.end()) {
-      length = std::max(0.3 * length, length - radius + kTipBeyondEndMm * s);
-    }
+    if (distal) length = std::max(0.3 * length, length - radius + kTipBeyondEndMm * s);
     AppendCapsule(model, model.model_from_bone_rest[bone], length, radius, radius,
-                  metacarpal ? 0.7 : 0.9, segments, JointBlendWeights(model, bone));
+                  {metacarpal ? 0.7 : 0.9, 2.0}, segments, JointBlendWeights(model, bone));
   }
   model.rest_mesh.ComputeVertexNormals();
   model.Check();

@@ -24,8 +24,20 @@ struct ProceduralHandOptions {
                                                              {76.3, 37.7, 21.1, 21.6}}};
   /// Thumb: metacarpal, proximal, distal phalanx.
   std::array<double, 3> thumb_lengths_mm = {52.6, 33.5, 25.2};
-  /// Phalanx radius of pinky, ring, middle, index, thumb.
-  std::array<double, 5> finger_radius_mm = {7.0, 7.8, 8.2, 8.0, 9.5};
+  /// Radius of the proximal phalanx of pinky, ring, middle, index, thumb: half the adult
+  /// finger breadth at the proximal joint (mean of men and women: index ≈ 19.5 mm, thumb ≈ 21 mm).
+  std::array<double, 5> finger_radius_mm = {8.3, 9.2, 9.7, 9.5, 10.5};
+  /// Radius of the distal phalanx relative to the proximal one (breadth at the distal joint ≈
+  /// 0.85 of that at the proximal joint); the middle phalanx lies halfway.
+  double distal_taper = 0.85;
+  /// Palm breadth across the metacarpal heads (the knuckles) and thickness there (adult mean ≈
+  /// 85 × 28 mm); breadth at the wrist crease (≈ 0.8 of that at the knuckles).
+  double palm_width_mm = 84.0;
+  double palm_base_width_mm = 68.0;
+  double palm_thickness_mm = 28.0;
+  /// Wrist breadth and thickness (adult mean ≈ 60 × 40 mm).
+  double wrist_width_mm = 60.0;
+  double wrist_thickness_mm = 38.0;
   /// Segments around each capsule.
   int segments = 16;
 

@@ -59,8 +59,13 @@ void CheckGradients(const HandModel& model, std::mt19937& rng) {
       {index, Eigen::Vector3d(5, 0, 0), 200, middle, Eigen::Vector3d(8, 0, 0), 200}};
   std::vector<double> prior(pose.angles_rad.size());
   for (double& a : prior) a = 0.2 * unit(rng);
-  HandFitCost cost(model, parameters.reference_rotation(), pairs, planes, collisions, 10.0, 30.0,
-                   1.5, prior);
+  std::vector<SilhouettePair> silhouette;
+  for (int i = 0; i < 20; ++i) {
+    silhouette.push_back(
+        {vertex(rng), Eigen::Vector2d(320 + 100 * unit(rng), 240 + 100 * unit(rng)), 0.4});
+  }
+  HandFitCost cost(model, parameters.reference_rotation(), CameraIntrinsics::Carmine109(),
+                   {pairs, planes, silhouette, collisions}, 10.0, 30.0, 1.5, prior);
   // Central differences (Ceres' own GradientChecker hands Eigen matrices across the library
   // boundary, which breaks when only this side is built with AddressSanitizer).
   const int n = static_cast<int>(parameters.values().size());
@@ -195,7 +200,7 @@ TEST(HandFitterTest, TracksTheRealHandOfARecordedSession) {
   options.object = "sphere";
   options.motion = "recorded:" + (data / "sequences" / "004-sphere").string();
   options.last_frame = 90;
-  // Measured: 1.44 mm mean, 2.44 mm worst over frames 0–150 (same model as rendered).
+  // Measured: 1.63 mm mean, 4.04 mm worst over frames 0–90 (same model as rendered).
   EXPECT_LT(TrackFromTheFirstPose(options), 3.0);
 }
 
@@ -204,10 +209,9 @@ TEST(HandFitterTest, TracksTheScriptedMotionCoarsely) {
   options.object = "sphere";
   options.scripted.frames = 240;
   options.last_frame = 79;
-  // Measured 7.8 mm mean over these 80 frames (15.8 mm over 240 before model points outside the
-  // crop volume stopped being matched): the hand holds the object from behind, mostly hidden,
-  // and its wrist drifts. A regression guard while the tracker is made robust.
-  EXPECT_LT(TrackFromTheFirstPose(options), 25.0);
+  // Measured 8.6 mm mean, 13.3 mm worst over these 80 frames: the hand holds the object from
+  // behind, mostly hidden, and its wrist drifts.
+  EXPECT_LT(TrackFromTheFirstPose(options), 15.0);
 }
 
 }  // namespace
