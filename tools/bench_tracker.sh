@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The hand tracker's benchmark: generator sequences from the paper's four recorded hand motions
-# (full sensor noise), tracked with the procedural template and with the real hand model, both
-# started from the ground truth's first pose. Prints joint error, contact error and ms/frame.
+# (full sensor noise), tracked with the procedural template (its scale estimated over the first
+# frames) and with the real hand model, both started from the ground truth's first pose. Prints
+# the template's scale, joint error, contact error and ms/frame.
 #   tools/bench_tracker.sh [FRAMES] [DATA_DIR] [WORK_DIR]
 # FRAMES: the first FRAMES frames of each session (default 300; "all" for whole sessions).
 set -euo pipefail
@@ -15,7 +16,8 @@ range=()
 [[ "$frames" == all ]] || range=(--frames "0:$((frames - 1))")
 declare -A objects=([001-water-bottle]=water-bottle [002-bowling-pin]=bowling-pin
                     [003-small-bottle]=small-bottle [004-sphere]=sphere)
-printf '%-18s %-11s %16s %18s %10s %8s\n' session template "joint error (mm)" "contact error (mm)" "ms/frame" lost
+printf '%-18s %-11s %6s %16s %18s %10s %8s\n' session template scale "joint error (mm)" \
+  "contact error (mm)" "ms/frame" lost
 for session in 001-water-bottle 002-bowling-pin 003-small-bottle 004-sphere; do
   out="$work/$session"
   "$build/tools/inhandscan-synth" --object "${objects[$session]}" \
@@ -29,7 +31,8 @@ import json, sys
 s = json.load(open(sys.argv[1]))["summary"]
 counts = s["status_counts"]
 lost = counts.get("diverged", 0) + counts.get("no_hand", 0)
-print("%-18s %-11s %16.2f %18s %10.1f %8d" % (sys.argv[2], sys.argv[3], s.get("joint_error_mm_mean", float("nan")),
+print("%-18s %-11s %6.3f %16.2f %18s %10.1f %8d" % (sys.argv[2], sys.argv[3], s["hand_scale"],
+      s.get("joint_error_mm_mean", float("nan")),
       "%.2f" % s["contact_error_mm_median"] if "contact_error_mm_median" in s else "-", s["ms_mean"], lost))
 PY
   done

@@ -51,6 +51,9 @@ int main(int argc, char** argv) {
   app.add_option("--motion", options.motion,
                  "scripted, or recorded:DIR (a session folder of the real hand data)")
       ->capture_default_str();
+  app.add_option("--hand-scale", options.hand_scale,
+                 "the hand's size relative to the template (scripted motion)")
+      ->check(CLI::Range(0.5, 2.0));
   app.add_option("--hand", options.hand, "procedural, or the real hand data folder")
       ->capture_default_str();
   app.add_option("--frames", frames, "frame range A:B of the motion (default: all)");

@@ -36,16 +36,15 @@ double Quantile(std::vector<double> values, double q) {
   return values[static_cast<size_t>(q * (values.size() - 1))];
 }
 
+// hand_scale: the template's scale, or 0 to estimate it over the first frames.
 int Run(const std::string& input, const fs::path& out, const std::string& gt_dir, bool init_from_gt,
         const std::string& template_name, double hand_scale) {
-  HandModel model;
-  if (template_name == "procedural") {
-    ihs::tracker::ProceduralHandOptions options;
-    options.scale = hand_scale;
-    model = ihs::tracker::MakeProceduralHand(options);
-  } else {
-    model = ihs::tracker::LoadHandModel(template_name);
-  }
+  HandModel model = template_name == "procedural" ? ihs::tracker::MakeProceduralHand()
+                                                  : ihs::tracker::LoadHandModel(template_name);
+  // The procedural template's size is estimated unless given; a scanned hand has its owner's.
+  ihs::tracker::TrackerOptions options;
+  if (hand_scale > 0) model = model.Scaled(hand_scale);
+  if (hand_scale > 0 || template_name != "procedural") options.scale_frames = 0;
   // Ground truth: joints per frame and the object's trajectory.
   std::vector<ihs::tracker::HandJointsRow> gt_joints;
   std::vector<ihs::StampedPose> gt_trajectory;
@@ -58,7 +57,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
 
   auto source = ihs::sensor::OpenInput(input);
   source->Start();
-  ihs::tracker::HandTracker tracker(model, source->Intrinsics());
+  ihs::tracker::HandTracker tracker(model, source->Intrinsics(), options);
   std::error_code error;
   fs::create_directories(out, error);
   if (error) throw ihs::OutputError(out.string() + ": cannot create (" + error.message() + ")");
@@ -132,6 +131,8 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   double total_ms = 0;
   for (double ms : milliseconds) total_ms += ms;
   nlohmann::json summary = {{"frames", index},
+                             {"hand_scale", tracker.scale() * (hand_scale > 0 ? hand_scale : 1.0)},
+                             {"hand_scale_estimated", options.scale_frames > 0},
                             {"status_counts", counts},
                             {"ms_mean", total_ms / index},
                             {"ms_p95", Quantile(milliseconds, 0.95)},
@@ -153,6 +154,8 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   std::printf("frames %lld: tracked %d, initialised %d, diverged %d, no hand %d, empty %d\n",
               static_cast<long long>(index), counts["tracked"], counts["initialised"],
               counts["diverged"], counts["no_hand"], counts["empty_frame"]);
+  std::printf("hand scale: %.3f (%s)\n", summary["hand_scale"].get<double>(),
+              options.scale_frames > 0 ? "estimated over the first frames" : "given");
   std::printf(
       "time per frame: %.1f ms mean, %.1f ms p95 (one core); segmentation %.1f, fit %.1f, "
       "contacts %.1f ms\n",
@@ -181,16 +184,16 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("inhandscan-track ") + IHS_VERSION);
   std::string input, out, gt, template_name = "procedural", log_level = "info";
   bool init_from_gt = false, quiet = false;
-  double hand_scale = 1.0;
+  double hand_scale = 0.0;
   app.add_option("input", input, ".oni file or TUM folder")->required();
   app.add_option("--out", out, "output folder")->required();
   app.add_option("--gt", gt, "a generator's gt/ folder: measure joint and contact errors");
   app.add_flag("--init-from-gt", init_from_gt, "start from the ground truth's first pose");
   app.add_option("--template", template_name, "procedural, or the real hand data folder")
       ->capture_default_str();
-  app.add_option("--hand-scale", hand_scale, "scale of the procedural template")
-      ->check(CLI::Range(0.5, 2.0))
-      ->capture_default_str();
+  app.add_option("--hand-scale", hand_scale,
+                 "scale of the template (default: the procedural one estimated over the first frames, a scanned one 1)")
+      ->check(CLI::Range(0.5, 2.0));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
   try {

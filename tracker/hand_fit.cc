@@ -524,11 +524,14 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     covered += std::sqrt(d2) <= kCoverageMm;
   }
   int visible_covered = 0;
+  double model_sum = 0;
   for (int i : visible_samples) {
     float d2 = 0;
     data_tree.Nearest(posed[i], &d2);
     visible_covered += std::sqrt(d2) <= kCoverageMm;
+    model_sum += std::sqrt(d2);
   }
+  result.model_error_mm = visible_samples.empty() ? 0 : model_sum / visible_samples.size();
   result.pose = pose;
   result.data_error_mm = sum / data.size();
   result.data_coverage = static_cast<double>(covered) / data.size();

@@ -60,8 +60,10 @@ struct HandFitOptions {
 /// The fitted pose and how well it explains the data.
 struct HandFitResult {
   HandPose pose;
-  /// Mean distance of the (subsampled) data points to the nearest model point, mm.
+  /// Mean distance of the (subsampled) data points to the nearest model point, and of the
+  /// visible model points to the nearest data point, mm.
   double data_error_mm = 0;
+  double model_error_mm = 0;
   /// Share of data points within 10 mm of the model, and of visible model points within 10 mm
   /// of the data.
   double data_coverage = 0;

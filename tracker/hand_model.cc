@@ -1,6 +1,7 @@
 #include "tracker/hand_model.h"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "core/errors.h"
 
@@ -29,6 +30,16 @@ int HandModel::FingerOf(int bone) const {
   const std::string& name = bones.at(bone).name;
   if (name.rfind("RFing.", 0) != 0 || name.size() < 7 || name[6] < '0' || name[6] > '4') return -1;
   return name[6] - '0';
+}
+
+HandModel HandModel::Scaled(double scale) const {
+  if (!(scale > 0)) throw std::invalid_argument("hand model scale must be positive");
+  HandModel scaled = *this;
+  for (Bone& bone : scaled.bones) bone.length_mm *= scale;
+  for (Rigid3& rest : scaled.model_from_bone_rest)
+    rest = Rigid3(rest.rotation(), scale * rest.translation());
+  for (Eigen::Vector3f& vertex : scaled.rest_mesh.vertices) vertex *= static_cast<float>(scale);
+  return scaled;
 }
 
 void HandModel::Check() const {

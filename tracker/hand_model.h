@@ -65,6 +65,10 @@ struct HandModel {
   /// Throws ihs::InputError describing the first inconsistency (sizes, parent order, weights).
   void Check() const;
 
+  /// The model scaled uniformly about the model frame's origin: bone lengths, rest placements and
+  /// the mesh (a user's hand of other size than the template's). Limits and weights are kept.
+  HandModel Scaled(double scale) const;
+
   /// The mesh posed by linear blend skinning: each vertex moves by Σ_j w_j·(cam_from_bone_j ·
   /// model_from_bone_rest_j⁻¹). `cam_from_bone` has one transform per bone. Normals recomputed.
   TriangleMesh Pose(const std::vector<Rigid3>& cam_from_bone) const;

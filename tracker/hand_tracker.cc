@@ -1,9 +1,12 @@
 #include "tracker/hand_tracker.h"
 
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <string>
 
 #include "core/check.h"
 #include "tracker/point_kd_tree.h"
@@ -52,6 +55,9 @@ void TrackerOptions::Check() const {
   IHS_CHECK_ARG(diverged_frames_to_reinitialise >= 1,
                 "tracker.diverged_frames_to_reinitialise must be >= 1");
   IHS_CHECK_ARG(initialisation_iterations >= 1, "tracker.initialisation_iterations must be >= 1");
+  IHS_CHECK_ARG(scale_frames >= 0, "tracker.scale_frames must be >= 0");
+  IHS_CHECK_ARG(scale_range >= 0 && scale_range < 0.5, "tracker.scale_range must be in [0, 0.5)");
+  IHS_CHECK_ARG(scale_step > 0, "tracker.scale_step must be positive");
 }
 
 namespace {
@@ -71,17 +77,95 @@ HandFitOptions InitialFitOptions(const TrackerOptions& options) {
 }
 }  // namespace
 
+// A template scale being tried: the scaled model, its fitter and its summed score.
+struct HandTracker::ScaleCandidate {
+  double scale = 1.0;
+  HandModel model;
+  std::unique_ptr<HandFitter> fitter;
+  double score = 0;
+};
+
 HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
                          TrackerOptions options)
-    : model_(std::move(model)),
+    : base_model_(std::move(model)),
+      model_(base_model_),
       intrinsics_(intrinsics),
       options_((options.Check(), std::move(options))),
-      segmenter_(intrinsics, options_.segmentation),
-      fitter_(model_, intrinsics, FitOptions(options_)),
-      initial_fitter_(model_, intrinsics, InitialFitOptions(options_)),
-      contacts_(model_, options_.contacts) {}
+      segmenter_(intrinsics, options_.segmentation) {
+  BuildStages();
+  if (options_.scale_frames > 0 && options_.scale_range > 0) {
+    HandFitOptions fit = FitOptions(options_);
+    fit.outer_iterations = std::min(fit.outer_iterations, 6);
+    const int steps = static_cast<int>(std::floor(options_.scale_range / options_.scale_step + 1e-6));
+    for (int k = -steps; k <= steps; ++k) {
+      auto candidate = std::make_unique<ScaleCandidate>();
+      candidate->scale = 1.0 + k * options_.scale_step;
+      candidate->model = base_model_.Scaled(candidate->scale);
+      candidate->fitter = std::make_unique<HandFitter>(candidate->model, intrinsics_, fit);
+      scale_candidates_.push_back(std::move(candidate));
+    }
+  }
+}
 
 HandTracker::~HandTracker() = default;
+
+void HandTracker::BuildStages() {
+  fitter_ = std::make_unique<HandFitter>(model_, intrinsics_, FitOptions(options_));
+  initial_fitter_ = std::make_unique<HandFitter>(model_, intrinsics_, InitialFitOptions(options_));
+  contacts_ = std::make_unique<ContactDetector>(model_, options_.contacts);
+}
+
+HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) const {
+  // The rest joints' centroid in the root's frame, at the base scale; it scales with the model.
+  const std::vector<Eigen::Vector3d> joints =
+      base_model_.JointPositions(ForwardKinematics(base_model_, HandPose::Rest(base_model_)));
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& joint : joints) centre += joint;
+  centre = base_model_.model_from_bone_rest[0].Inverse() * Eigen::Vector3d(centre / joints.size());
+  HandPose out = pose;
+  out.cam_from_root =
+      Rigid3(pose.cam_from_root.rotation(),
+             pose.cam_from_root.translation() +
+                 pose.cam_from_root.rotation() * ((from - to) * centre));
+  return out;
+}
+
+void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& frame) {
+  for (auto& candidate : scale_candidates_) {
+    const HandFitResult fit = candidate->fitter->Fit(
+        segmentation.hand_points, &frame, Rescaled(pose_, scale_, candidate->scale),
+        &segmentation);
+    // How far the hand points are from the model, and the model's visible points from them.
+    candidate->score += fit.data_error_mm + fit.model_error_mm;
+  }
+  if (++scale_frames_done_ < options_.scale_frames) return;
+  size_t best = 0;
+  for (size_t k = 1; k < scale_candidates_.size(); ++k) {
+    if (scale_candidates_[k]->score < scale_candidates_[best]->score) best = k;
+  }
+  double scale = scale_candidates_[best]->scale;
+  if (best > 0 && best + 1 < scale_candidates_.size()) {
+    // The minimum of the parabola through the best score and its neighbours.
+    const double a = scale_candidates_[best - 1]->score, b = scale_candidates_[best]->score,
+                 c = scale_candidates_[best + 1]->score;
+    const double curvature = a - 2 * b + c;
+    if (curvature > 1e-9) scale += 0.5 * options_.scale_step * (a - c) / curvature;
+  }
+  std::string scores;
+  for (const auto& candidate : scale_candidates_) {
+    scores += fmt::format(" {:.2f}: {:.2f}", candidate->scale,
+                          candidate->score / options_.scale_frames);
+  }
+  spdlog::debug("hand scale {:.3f} from mean scores{}", scale, scores);
+  scale_candidates_.clear();
+  pose_ = Rescaled(pose_, scale_, scale);
+  has_previous_ = false;
+  previous_vertices_.clear();
+  previous_contact_vertices_.clear();
+  scale_ = scale;
+  model_ = base_model_.Scaled(scale_);
+  BuildStages();
+}
 
 void HandTracker::Initialise(const HandPose& pose) {
   pose_ = pose;
@@ -115,7 +199,7 @@ HandFitResult HandTracker::InitialiseFromCloud(const std::vector<Eigen::Vector3f
       const Eigen::Matrix3d rotation = axes * rest_axes.transpose();
       const Rigid3 cam_from_model(rotation, centre - rotation * rest_centre);
       const HandFitResult fit =
-          initial_fitter_.Fit(hand_points, &frame, HandPose::Rest(model_, cam_from_model));
+          initial_fitter_->Fit(hand_points, &frame, HandPose::Rest(model_, cam_from_model));
       const double score =
           fit.data_error_mm + 20.0 * (1.0 - fit.data_coverage) + 20.0 * (1.0 - fit.model_coverage);
       if (score < best_score) best_score = score, best = fit;
@@ -167,7 +251,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
       predicted.cam_from_root =
           pose_.cam_from_root * previous_pose_.cam_from_root.Inverse() * pose_.cam_from_root;
     }
-    result.fit = fitter_.Fit(points, &frame, predicted, &result.segmentation);
+    result.fit = fitter_->Fit(points, &frame, predicted, &result.segmentation);
     result.status = TrackStatus::kTracked;
   }
   if (result.fit.data_coverage < options_.min_data_coverage) {
@@ -187,12 +271,14 @@ TrackResult HandTracker::Track(const Frame& frame) {
     diverged_in_a_row_ = 0;
   }
 
-  result.fit_ms = since(stage);
-  stage = std::chrono::steady_clock::now();
   previous_pose_ = pose_;
   has_previous_ = has_pose_ && result.status == TrackStatus::kTracked;
   pose_ = result.fit.pose;
   has_pose_ = true;
+  if (estimating_scale() && result.HasPose()) EstimateScale(result.segmentation, frame);
+  result.fit_ms = since(stage);
+  stage = std::chrono::steady_clock::now();
+  result.hand_scale = scale_;
   result.pose = pose_;
   const std::vector<Rigid3> cam_from_bone = ForwardKinematics(model_, pose_);
   result.joints_mm = model_.JointPositions(cam_from_bone);
@@ -201,7 +287,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   const std::vector<Eigen::Vector3f> vertices = model_.Pose(cam_from_bone).vertices;
   if (!result.segmentation.object_points.empty() && result.HasPose()) {
     const PointKdTree object(result.segmentation.object_points);
-    result.contacts = contacts_.Detect(vertices, object);
+    result.contacts = contacts_->Detect(vertices, object);
     if (!previous_vertices_.empty()) {
       for (int v : result.contacts.vertices) {
         if (std::binary_search(previous_contact_vertices_.begin(), previous_contact_vertices_.end(),

@@ -31,6 +31,14 @@ struct TrackerOptions {
   int diverged_frames_to_reinitialise = 2;
   /// Levenberg–Marquardt iterations (outer) for each initialisation hypothesis.
   int initialisation_iterations = 8;
+  /// The template's size is estimated over this many frames with a hand (0: the template is
+  /// used at the size it comes in): on each, the pose is fitted at every candidate scale in
+  /// 1 ± scale_range (steps of scale_step), and the scale that explains the hand points best
+  /// over all of them is kept (refined between the steps). The tracker runs at the template's
+  /// own size meanwhile.
+  int scale_frames = 10;
+  double scale_range = 0.15;
+  double scale_step = 0.05;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -69,6 +77,8 @@ struct TrackResult {
   std::vector<ContactPair> contact_pairs;
   Segmentation segmentation;
   HandFitResult fit;
+  /// The template's scale in use (1 until an estimate is made; see TrackerOptions).
+  double hand_scale = 1.0;
   /// Time spent on this frame, ms: in all, and on segmentation, the pose fit (with any
   /// re-initialisation) and the contacts.
   double milliseconds = 0;
@@ -95,20 +105,36 @@ class HandTracker {
   /// Processes the next frame (depth in mm with registered colour).
   TrackResult Track(const Frame& frame);
 
+  /// The template at its current scale (it changes once, when the scale estimate is made).
   const HandModel& model() const { return model_; }
+  double scale() const { return scale_; }
+  /// Whether the template's scale is still being estimated.
+  bool estimating_scale() const { return !scale_candidates_.empty(); }
   const TrackerOptions& options() const { return options_; }
 
  private:
+  struct ScaleCandidate;
   HandFitResult InitialiseFromCloud(const std::vector<Eigen::Vector3f>& hand_points,
                                     const Frame& frame) const;
+  // Builds the fitters and the contact detector for model_.
+  void BuildStages();
+  // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's
+  // middle where it was.
+  HandPose Rescaled(const HandPose& pose, double from, double to) const;
+  // One frame of the scale estimate; switches to the estimated scale after the last frame.
+  void EstimateScale(const Segmentation& segmentation, const Frame& frame);
 
-  const HandModel model_;
+  const HandModel base_model_;
+  HandModel model_;
+  double scale_ = 1.0;
   const CameraIntrinsics intrinsics_;
   const TrackerOptions options_;
   Segmenter segmenter_;
-  HandFitter fitter_;
-  HandFitter initial_fitter_;
-  ContactDetector contacts_;
+  std::unique_ptr<HandFitter> fitter_;
+  std::unique_ptr<HandFitter> initial_fitter_;
+  std::unique_ptr<ContactDetector> contacts_;
+  std::vector<std::unique_ptr<ScaleCandidate>> scale_candidates_;
+  int scale_frames_done_ = 0;
   bool has_pose_ = false;
   HandPose pose_;
   HandPose previous_pose_;

@@ -18,9 +18,11 @@ class SkinColorModel;
 
 /// Options of the segmentation (defaults: the paper's crop volume).
 struct SegmentationOptions {
-  /// Crop volume in the camera frame, mm (paper: x ∈ [−100, 100], y ∈ [−140, 220], z ∈ [400,
-  /// 1000]).
-  Eigen::Vector3d crop_min_mm{-100, -140, 400};
+  /// Crop volume in the camera frame (x right, y down), mm. The paper's: x ∈ [−100, 100],
+  /// y ∈ [−140, 220], z ∈ [400, 1000]; here y reaches up to −220: in the paper's own sessions the
+  /// hand holds the object from above with its wrist up to 215 mm above the optical axis, and a
+  /// tracker that sees only the fingertips loses the hand.
+  Eigen::Vector3d crop_min_mm{-100, -220, 400};
   Eigen::Vector3d crop_max_mm{100, 220, 1000};
   /// A pixel is skin when log p(rgb | skin) − log p(rgb | non-skin) exceeds this.
   double skin_log_ratio = 0.0;

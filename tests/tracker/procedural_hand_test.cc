@@ -30,6 +30,28 @@ TEST(ProceduralHandTest, HasTheRealModelsTopologyAndAClosedMesh) {
   EXPECT_NEAR(hi.z() - lo.z(), 17.6 + 76 + 38 + 26 + 22, 40);  // Wrist to middle fingertip.
 }
 
+TEST(ProceduralHandTest, ScalingScalesBonesMeshAndPosedJointsAboutTheWrist) {
+  const HandModel hand = MakeProceduralHand();
+  const HandModel big = hand.Scaled(1.1);
+  EXPECT_NO_THROW(big.Check());
+  for (size_t b = 0; b < hand.bones.size(); ++b)
+    EXPECT_NEAR(big.bones[b].length_mm, 1.1 * hand.bones[b].length_mm, 1e-9);
+  for (size_t v = 0; v < hand.rest_mesh.vertices.size(); v += 97) {
+    EXPECT_LT((big.rest_mesh.vertices[v] - 1.1f * hand.rest_mesh.vertices[v]).norm(), 1e-4f);
+  }
+  // The same angles at the same root placement: every joint 1.1 times as far from the root.
+  HandPose pose = HandPose::Rest(hand, Rigid3::FromAxisAngle({1, 2, 0}, 0.5, {5, -10, 600}));
+  for (size_t k = 0; k < pose.angles_rad.size(); ++k) pose.angles_rad[k] = -0.2 - 0.01 * k;
+  HandPose big_pose = pose;
+  big_pose.cam_from_root = Rigid3(pose.cam_from_root.rotation(), pose.cam_from_root.translation());
+  const auto joints = hand.JointPositions(ForwardKinematics(hand, pose));
+  const auto big_joints = big.JointPositions(ForwardKinematics(big, big_pose));
+  const Eigen::Vector3d root = pose.cam_from_root.translation();
+  for (size_t j = 0; j < joints.size(); ++j)
+    EXPECT_LT((big_joints[j] - root - 1.1 * (joints[j] - root)).norm(), 1e-6) << j;
+  EXPECT_THROW(hand.Scaled(0.0), std::invalid_argument);
+}
+
 TEST(ProceduralHandTest, FlexionBendsFingersTowardThePalmAndKeepsTheSurface) {
   const HandModel hand = MakeProceduralHand();
   const auto dofs = JointDegreesOfFreedom(hand);

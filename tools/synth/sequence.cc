@@ -81,6 +81,9 @@ void SequenceOptions::Check() const {
   IHS_CHECK_ARG(touch_mm > 0, "touch_mm must be positive");
   IHS_CHECK_ARG(motion == "scripted" || motion.rfind("recorded:", 0) == 0,
                 "motion must be 'scripted' or 'recorded:DIR', got '" << motion << "'");
+  IHS_CHECK_ARG(hand_scale >= 0.5 && hand_scale <= 2.0, "hand scale must be in [0.5, 2]");
+  IHS_CHECK_ARG(hand_scale == 1.0 || motion == "scripted",
+                "a hand scale needs the scripted motion (a recorded motion has its own hand)");
   intrinsics.Check();
   sensor.Check();
   scripted.Check();
@@ -107,6 +110,7 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     } else {
       hand_ = tracker::LoadHandModel(options_.hand);
     }
+    if (options_.hand_scale != 1.0) hand_ = hand_.Scaled(options_.hand_scale);
     motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }
   const int available = static_cast<int>(motion_.frames.size());
@@ -280,6 +284,7 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
         {"volume_mm3", object.mesh().Volume()}}},
       {"motion", options.motion},
       {"hand", options.hand},
+      {"hand_scale", options.hand_scale},
       {"hand_bones", bone_names.size()},
       {"frames", {{"first", options.first_frame}, {"last", last}, {"count", count}}},
       {"seed", options.seed},

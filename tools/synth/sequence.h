@@ -45,6 +45,9 @@ struct SequenceOptions {
   /// motion needs the real hand; when left "procedural" it uses the data folder two levels above
   /// the session folder.
   std::string hand = "procedural";
+  /// The hand's size relative to the template (scripted motion only: a recorded motion comes
+  /// with its own hand).
+  double hand_scale = 1.0;
   /// Frames [first_frame, last_frame] of the motion (last_frame −1: to the end).
   int first_frame = 0;
   int last_frame = -1;
