@@ -26,8 +26,8 @@ struct HandFitOptions {
   int inner_iterations = 5;
   /// Data points matched to the model (data → model) and visible model points matched to the
   /// data (model → data), at most; both are subsampled evenly.
-  int max_data_points = 300;
-  int max_model_points = 300;
+  int max_data_points = 200;
+  int max_model_points = 200;
   /// Pairs farther apart than this are dropped, mm.
   double max_correspondence_mm = 40.0;
   /// Pairs farther apart than this count with a Huber weight, mm.

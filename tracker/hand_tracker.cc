@@ -95,7 +95,7 @@ HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
   BuildStages();
   if (options_.scale_frames > 0 && options_.scale_range > 0) {
     HandFitOptions fit = FitOptions(options_);
-    fit.outer_iterations = std::min(fit.outer_iterations, 6);
+    fit.outer_iterations = std::min(fit.outer_iterations, 3);
     const int steps = static_cast<int>(std::floor(options_.scale_range / options_.scale_step + 1e-6));
     for (int k = -steps; k <= steps; ++k) {
       auto candidate = std::make_unique<ScaleCandidate>();
@@ -286,7 +286,22 @@ TrackResult HandTracker::Track(const Frame& frame) {
   // Contacts with the object's points, and those held since the previous frame.
   const std::vector<Eigen::Vector3f> vertices = model_.Pose(cam_from_bone).vertices;
   if (!result.segmentation.object_points.empty() && result.HasPose()) {
-    const PointKdTree object(result.segmentation.object_points);
+    // Only object points near the fingertips can touch them: those in the box around the
+    // distal phalanges' bones, grown by a finger's radius and the largest contact threshold.
+    Eigen::Vector3f low = Eigen::Vector3f::Constant(1e9f), high = -low;
+    for (int end : model_.EndEffectors()) {
+      for (int joint : {end + 1, model_.bones[end].parent + 1}) {
+        const Eigen::Vector3f p = result.joints_mm[joint].cast<float>();
+        low = low.cwiseMin(p), high = high.cwiseMax(p);
+      }
+    }
+    const float margin = 20.0f + static_cast<float>(options_.contacts.max_mm);
+    low.array() -= margin, high.array() += margin;
+    std::vector<Eigen::Vector3f> near;
+    for (const Eigen::Vector3f& p : result.segmentation.object_points) {
+      if ((p.array() >= low.array()).all() && (p.array() <= high.array()).all()) near.push_back(p);
+    }
+    const PointKdTree object(std::move(near));
     result.contacts = contacts_->Detect(vertices, object);
     if (!previous_vertices_.empty()) {
       for (int v : result.contacts.vertices) {
