@@ -1,0 +1,291 @@
+#include "fusion/tsdf_volume.h"
+
+#include <pcl/surface/marching_cubes.h>  // The marching-cubes case tables (edgeTable, triTable).
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "core/check.h"
+
+namespace ihs::fusion {
+namespace {
+
+constexpr float kTsdfScale = 32767.0f;
+
+// Cell corners (as offsets) and edges (as corner pairs) in the order of the case tables.
+constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                               {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                              {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+
+}  // namespace
+
+void TsdfOptions::Check() const {
+  IHS_CHECK_ARG(size_mm > 0, "tsdf.size_mm must be positive, got " << size_mm);
+  IHS_CHECK_ARG(resolution >= 8 && resolution <= 1024,
+                "tsdf.resolution must be in [8, 1024], got " << resolution);
+  IHS_CHECK_ARG(truncation_voxels >= 1 && truncation_voxels <= 64,
+                "tsdf.truncation_voxels must be in [1, 64], got " << truncation_voxels);
+  IHS_CHECK_ARG(max_weight >= 1 && max_weight <= 65535,
+                "tsdf.max_weight must be in [1, 65535], got " << max_weight);
+}
+
+TsdfVolume::TsdfVolume(TsdfOptions options)
+    : options_((options.Check(), options)),
+      n_(options_.resolution),
+      voxel_mm_(options_.size_mm / options_.resolution),
+      truncation_mm_(options_.truncation_voxels * voxel_mm_),
+      voxels_(static_cast<size_t>(n_) * n_ * n_) {}
+
+Eigen::Vector3f TsdfVolume::Centre(int i, int j, int k) const {
+  const double half = 0.5 * options_.size_mm;
+  return Eigen::Vector3d(-half + (i + 0.5) * voxel_mm_, -half + (j + 0.5) * voxel_mm_,
+                         -half + (k + 0.5) * voxel_mm_)
+      .cast<float>();
+}
+
+std::int64_t TsdfVolume::ObservedVoxels() const {
+  return std::count_if(voxels_.begin(), voxels_.end(), [](const Voxel& v) { return v.weight > 0; });
+}
+
+int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& mask,
+                          const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume) {
+  IHS_CHECK_ARG(mask.empty() || mask.size() == frame.depth_mm.size(),
+                "mask has " << mask.size() << " entries, the frame " << frame.depth_mm.size());
+  IHS_CHECK_ARG(frame.width == intrinsics.width && frame.height == intrinsics.height,
+                "frame " << frame.width << "x" << frame.height << " but intrinsics "
+                         << intrinsics.width << "x" << intrinsics.height);
+  const Rigid3 volume_from_cam = cam_from_volume.Inverse();
+  const Eigen::Matrix3f rotation = volume_from_cam.rotation().cast<float>();
+  const Eigen::Vector3f translation = volume_from_cam.translation().cast<float>();
+  const float half = static_cast<float>(0.5 * options_.size_mm);
+  const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
+  auto observed = [&](int pixel) {
+    return frame.depth_mm[pixel] != 0 && (mask.empty() || mask[pixel] != 0);
+  };
+
+  // The voxels within the band around each observed pixel's surface point, along its ray.
+  std::vector<std::int64_t> touched;
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const int pixel = v * frame.width + u;
+      if (!observed(pixel)) continue;
+      const Eigen::Vector3f point =
+          intrinsics.BackProject(u, v, frame.depth_mm[pixel]).cast<float>();
+      const Eigen::Vector3f ray = point.normalized();
+      for (float t = -band; t <= band; t += 0.5f * voxel) {
+        const Eigen::Vector3f grid = (rotation * (point + t * ray) + translation).array() + half;
+        const int i = static_cast<int>(std::floor(grid.x() / voxel));
+        const int j = static_cast<int>(std::floor(grid.y() / voxel));
+        const int k = static_cast<int>(std::floor(grid.z() / voxel));
+        if (i < 0 || j < 0 || k < 0 || i >= n_ || j >= n_ || k >= n_) continue;
+        touched.push_back(Index(i, j, k));
+      }
+    }
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+
+  // Projective update of each: the distance along the ray from the voxel to the surface seen
+  // through its pixel.
+  const Eigen::Matrix3f cam_rotation = cam_from_volume.rotation().cast<float>();
+  const Eigen::Vector3f cam_translation = cam_from_volume.translation().cast<float>();
+  const bool color = options_.color && frame.HasColor();
+  int updated = 0;
+  for (const std::int64_t index : touched) {
+    const int i = static_cast<int>(index % n_), j = static_cast<int>((index / n_) % n_),
+              k = static_cast<int>(index / (static_cast<std::int64_t>(n_) * n_));
+    const Eigen::Vector3f centre = cam_rotation * Centre(i, j, k) + cam_translation;
+    if (centre.z() <= 0) continue;
+    const float x = static_cast<float>(intrinsics.fx) * centre.x() / centre.z() +
+                    static_cast<float>(intrinsics.cx);
+    const float y = static_cast<float>(intrinsics.fy) * centre.y() / centre.z() +
+                    static_cast<float>(intrinsics.cy);
+    const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
+    if (u < 0 || v < 0 || u >= frame.width || v >= frame.height) continue;
+    const int pixel = v * frame.width + u;
+    if (!observed(pixel)) continue;
+    const float along_ray = std::sqrt(centre.squaredNorm()) / centre.z();
+    const float distance = (frame.depth_mm[pixel] - centre.z()) * along_ray;
+    if (distance < -band) continue;  // Behind the surface: not seen.
+    const float tsdf = std::min(1.0f, distance / band);
+    Voxel& voxel_ref = voxels_[index];
+    const float weight = voxel_ref.weight;
+    const float mean = (voxel_ref.tsdf / kTsdfScale * weight + tsdf) / (weight + 1);
+    voxel_ref.tsdf = static_cast<std::int16_t>(std::lround(mean * kTsdfScale));
+    if (color && std::abs(distance) < band) {
+      for (int c = 0; c < 3; ++c) {
+        const float value = frame.rgb[3 * pixel + c];
+        voxel_ref.rgb[c] = static_cast<std::uint8_t>(
+            std::lround((voxel_ref.rgb[c] * weight + value) / (weight + 1)));
+      }
+    }
+    voxel_ref.weight =
+        static_cast<std::uint16_t>(std::min<int>(options_.max_weight, voxel_ref.weight + 1));
+    ++updated;
+  }
+  return updated;
+}
+
+bool TsdfVolume::SignedDistance(const Eigen::Vector3f& point, float* distance_mm) const {
+  const float half = static_cast<float>(0.5 * options_.size_mm);
+  const Eigen::Vector3f grid = (point.array() + half) / static_cast<float>(voxel_mm_) - 0.5f;
+  const int i = static_cast<int>(std::floor(grid.x()));
+  const int j = static_cast<int>(std::floor(grid.y()));
+  const int k = static_cast<int>(std::floor(grid.z()));
+  if (i < 0 || j < 0 || k < 0 || i + 1 >= n_ || j + 1 >= n_ || k + 1 >= n_) return false;
+  const float fx = grid.x() - i, fy = grid.y() - j, fz = grid.z() - k;
+  float sum = 0;
+  for (int c = 0; c < 8; ++c) {
+    const Voxel& voxel = voxels_[Index(i + kCorner[c][0], j + kCorner[c][1], k + kCorner[c][2])];
+    if (voxel.weight == 0) return false;
+    const float w = (kCorner[c][0] ? fx : 1 - fx) * (kCorner[c][1] ? fy : 1 - fy) *
+                    (kCorner[c][2] ? fz : 1 - fz);
+    sum += w * voxel.tsdf;
+  }
+  *distance_mm = sum / kTsdfScale * static_cast<float>(truncation_mm_);
+  return true;
+}
+
+RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics,
+                                 const Rigid3& cam_from_volume) const {
+  RaycastImage image;
+  image.width = intrinsics.width;
+  image.height = intrinsics.height;
+  const size_t pixels = static_cast<size_t>(image.width) * image.height;
+  image.depth_mm.assign(pixels, 0.0f);
+  image.normals.assign(pixels, Eigen::Vector3f::Zero());
+  image.colors.assign(pixels, {0, 0, 0});
+  const Rigid3 volume_from_cam = cam_from_volume.Inverse();
+  const Eigen::Matrix3f rotation = volume_from_cam.rotation().cast<float>();
+  const Eigen::Vector3f origin = volume_from_cam.translation().cast<float>();
+  const Eigen::Matrix3f to_cam = cam_from_volume.rotation().cast<float>();
+  const float half = static_cast<float>(0.5 * options_.size_mm);
+  const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
+  for (int v = 0; v < image.height; ++v) {
+    for (int u = 0; u < image.width; ++u) {
+      const Eigen::Vector3f ray_cam = intrinsics.BackProject(u, v, 1.0).cast<float>();
+      const Eigen::Vector3f ray = rotation * ray_cam.normalized();
+      // Where the ray is inside the cube (slabs).
+      float t_near = 0, t_far = std::numeric_limits<float>::infinity();
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(ray[a]) < 1e-9f) {
+          if (std::abs(origin[a]) > half) t_far = -1;
+          continue;
+        }
+        float t0 = (-half - origin[a]) / ray[a], t1 = (half - origin[a]) / ray[a];
+        if (t0 > t1) std::swap(t0, t1);
+        t_near = std::max(t_near, t0), t_far = std::min(t_far, t1);
+      }
+      if (t_near >= t_far) continue;
+      float t = t_near + 0.5f * voxel, previous_t = 0, previous = 0;
+      bool has_previous = false;
+      while (t < t_far) {
+        float distance = 0;
+        if (!SignedDistance(origin + t * ray, &distance)) {
+          has_previous = false;
+          // An unobserved stretch: half-band steps land at least once in the band's front half.
+          t += 0.5f * band;
+          continue;
+        }
+        if (distance < 0) {
+          if (!has_previous || previous <= 0) break;  // Entered from behind: no front surface.
+          const float hit = previous_t + (t - previous_t) * previous / (previous - distance);
+          const Eigen::Vector3f point = origin + hit * ray;
+          const size_t pixel = static_cast<size_t>(v) * image.width + u;
+          image.depth_mm[pixel] = (hit * ray_cam.normalized()).z();
+          Eigen::Vector3f gradient;
+          bool ok = true;
+          for (int a = 0; a < 3 && ok; ++a) {
+            Eigen::Vector3f step = Eigen::Vector3f::Zero();
+            step[a] = voxel;
+            float plus = 0, minus = 0;
+            ok = SignedDistance(point + step, &plus) && SignedDistance(point - step, &minus);
+            gradient[a] = plus - minus;
+          }
+          if (ok && gradient.norm() > 1e-6f) image.normals[pixel] = to_cam * gradient.normalized();
+          const Eigen::Vector3f grid = (point.array() + half) / voxel;
+          const int i = std::clamp(static_cast<int>(grid.x()), 0, n_ - 1);
+          const int j = std::clamp(static_cast<int>(grid.y()), 0, n_ - 1);
+          const int k = std::clamp(static_cast<int>(grid.z()), 0, n_ - 1);
+          const Voxel& nearest = voxels_[Index(i, j, k)];
+          image.colors[pixel] = {nearest.rgb[0], nearest.rgb[1], nearest.rgb[2]};
+          break;
+        }
+        previous_t = t, previous = distance, has_previous = true;
+        t += std::max(voxel, 0.8f * distance);
+      }
+    }
+  }
+  return image;
+}
+
+TriangleMesh TsdfVolume::ExtractMesh() const {
+  TriangleMesh mesh;
+  std::unordered_map<std::int64_t, std::int32_t> vertex_of_edge;
+  const bool color = options_.color;
+  for (int k = 0; k + 1 < n_; ++k) {
+    for (int j = 0; j + 1 < n_; ++j) {
+      for (int i = 0; i + 1 < n_; ++i) {
+        float value[8];
+        const Voxel* corner[8];
+        int case_index = 0;
+        bool observed = true;
+        for (int c = 0; c < 8 && observed; ++c) {
+          corner[c] = &voxels_[Index(i + kCorner[c][0], j + kCorner[c][1], k + kCorner[c][2])];
+          observed = corner[c]->weight > 0;
+          value[c] = corner[c]->tsdf;
+          if (value[c] < 0) case_index |= 1 << c;
+        }
+        if (!observed || pcl::edgeTable[case_index] == 0) continue;
+        std::int32_t edge_vertex[12];
+        for (int e = 0; e < 12; ++e) {
+          if (!(pcl::edgeTable[case_index] & (1u << e))) continue;
+          const int a = kEdge[e][0], b = kEdge[e][1];
+          // The edge's key: its lower corner's voxel and its axis.
+          int axis = 0;
+          while (kCorner[a][axis] == kCorner[b][axis]) ++axis;
+          const int li = i + std::min(kCorner[a][0], kCorner[b][0]);
+          const int lj = j + std::min(kCorner[a][1], kCorner[b][1]);
+          const int lk = k + std::min(kCorner[a][2], kCorner[b][2]);
+          const std::int64_t key = Index(li, lj, lk) * 3 + axis;
+          const auto found = vertex_of_edge.find(key);
+          if (found != vertex_of_edge.end()) {
+            edge_vertex[e] = found->second;
+            continue;
+          }
+          const float s = value[a] / (value[a] - value[b]);
+          const Eigen::Vector3f pa =
+              Centre(i + kCorner[a][0], j + kCorner[a][1], k + kCorner[a][2]);
+          const Eigen::Vector3f pb =
+              Centre(i + kCorner[b][0], j + kCorner[b][1], k + kCorner[b][2]);
+          mesh.vertices.push_back(pa + s * (pb - pa));
+          if (color) {
+            TriangleMesh::Color rgb;
+            for (int c = 0; c < 3; ++c) {
+              rgb[c] = static_cast<std::uint8_t>(
+                  std::lround(corner[a]->rgb[c] + s * (corner[b]->rgb[c] - corner[a]->rgb[c])));
+            }
+            mesh.colors.push_back(rgb);
+          }
+          edge_vertex[e] = static_cast<std::int32_t>(mesh.vertices.size() - 1);
+          vertex_of_edge.emplace(key, edge_vertex[e]);
+        }
+        for (int t = 0; pcl::triTable[case_index][t] != -1; t += 3) {
+          // The tables wind triangles clockwise seen from outside (positive distance): reversed.
+          mesh.faces.push_back({edge_vertex[pcl::triTable[case_index][t]],
+                                edge_vertex[pcl::triTable[case_index][t + 2]],
+                                edge_vertex[pcl::triTable[case_index][t + 1]]});
+        }
+      }
+    }
+  }
+  mesh.ComputeVertexNormals();
+  return mesh;
+}
+
+}  // namespace ihs::fusion

@@ -1,0 +1,98 @@
+#pragma once
+// The object model: a truncated signed distance function (Curless & Levoy 1996, as KinectFusion
+// keeps it) on a dense cube of voxels in the object frame, with a colour per voxel. Integration
+// touches only the voxels within the truncation band of the observed pixels, so its cost grows
+// with the object's pixels, not with the volume; raycasting gives the model's surface as a
+// camera sees it (for ICP and previews); marching cubes gives its zero level set as a mesh.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+
+namespace ihs::fusion {
+
+/// Options of the TSDF volume (defaults: the paper's 350 mm cube at 256³).
+struct TsdfOptions {
+  /// Edge of the cube, mm (paper: 350).
+  double size_mm = 350.0;
+  /// Voxels per edge (paper: 256; 1.37 mm voxels).
+  int resolution = 256;
+  /// Signed distances are truncated to ± this many voxels.
+  double truncation_voxels = 4.0;
+  /// Cap of a voxel's integration weight: past this many observations the average keeps
+  /// following new ones instead of freezing.
+  int max_weight = 128;
+  /// Whether voxels keep a colour (the weighted mean of the pixels that saw them).
+  bool color = true;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// What the model looks like from a camera: per pixel (row-major, width·height), the depth of
+/// the model's surface (mm, camera frame; 0 where the ray misses it), its unit normal in the
+/// camera frame and its colour.
+struct RaycastImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> depth_mm;
+  std::vector<Eigen::Vector3f> normals;
+  std::vector<TriangleMesh::Color> colors;
+};
+
+/// A TSDF on a dense voxel cube centred on the origin of its own frame (the object frame:
+/// `volume` in transform names). 8 bytes per voxel (≈ 134 MB at 256³). Not thread-safe.
+class TsdfVolume {
+ public:
+  explicit TsdfVolume(TsdfOptions options = {});
+
+  /// Integrates the pixels of `frame` whose `mask` entry is non-zero (every pixel with depth
+  /// when `mask` is empty), seen by a camera with `intrinsics` at `cam_from_volume`. Returns the
+  /// number of voxels updated.
+  int Integrate(const Frame& frame, const std::vector<std::uint8_t>& mask,
+                const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume);
+
+  /// The model's surface seen from `cam_from_volume`: the first zero crossing along each ray.
+  RaycastImage Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume) const;
+
+  /// The zero level set by marching cubes (volume frame, mm), over cells whose eight corners
+  /// have all been observed; with per-vertex colour when kept. Vertices are shared between
+  /// cells, so a fully observed closed surface gives a closed mesh; normals point outward.
+  TriangleMesh ExtractMesh() const;
+
+  /// The truncated signed distance at `point` (volume frame, mm), in mm, interpolated
+  /// trilinearly; false where the point is outside the cube or a corner is unobserved.
+  bool SignedDistance(const Eigen::Vector3f& point, float* distance_mm) const;
+
+  double voxel_mm() const { return voxel_mm_; }
+  double truncation_mm() const { return truncation_mm_; }
+  const TsdfOptions& options() const { return options_; }
+  /// Voxels observed at least once.
+  std::int64_t ObservedVoxels() const;
+
+ private:
+  struct Voxel {
+    std::int16_t tsdf = 0;  // Signed distance / truncation, scaled to ±32767.
+    std::uint16_t weight = 0;
+    std::uint8_t rgb[3] = {0, 0, 0};
+    std::uint8_t unused = 0;
+  };
+  std::int64_t Index(int i, int j, int k) const {
+    return (static_cast<std::int64_t>(k) * n_ + j) * n_ + i;
+  }
+  // The centre of voxel (i, j, k) in the volume frame.
+  Eigen::Vector3f Centre(int i, int j, int k) const;
+
+  const TsdfOptions options_;
+  const int n_;
+  const double voxel_mm_;
+  const double truncation_mm_;
+  std::vector<Voxel> voxels_;
+};
+
+}  // namespace ihs::fusion

@@ -1,0 +1,165 @@
+// The TSDF volume on analytic views of a sphere: the mesh's radius, closedness and colour, the
+// band-limited integration, and the raycast.
+
+#include "fusion/tsdf_volume.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+namespace ihs::fusion {
+namespace {
+
+constexpr double kRadius = 35.0;  // The paper's sphere: Ø70 mm.
+
+// Depth (mm, rounded as a sensor would) and colour of a sphere of kRadius at the volume's origin
+// seen from `cam_from_volume`: red where the volume frame's x > 0, green elsewhere.
+Frame RenderSphere(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume) {
+  Frame frame = Frame::Blank(intrinsics.width, intrinsics.height, true);
+  const Eigen::Vector3d centre = cam_from_volume.translation();
+  const Rigid3 volume_from_cam = cam_from_volume.Inverse();
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
+      const double b = ray.dot(centre), c = centre.squaredNorm() - kRadius * kRadius;
+      const double discriminant = b * b - c;
+      if (discriminant < 0) continue;
+      const Eigen::Vector3d hit = (b - std::sqrt(discriminant)) * ray;
+      const int pixel = v * frame.width + u;
+      frame.depth_mm[pixel] = static_cast<std::uint16_t>(std::lround(hit.z()));
+      const bool red = (volume_from_cam * hit).x() > 0;
+      frame.rgb[3 * pixel] = red ? 220 : 30;
+      frame.rgb[3 * pixel + 1] = red ? 30 : 200;
+      frame.rgb[3 * pixel + 2] = 40;
+    }
+  }
+  return frame;
+}
+
+// Views from all around: the sphere 600 mm in front of the camera, turned about two axes.
+std::vector<Rigid3> ViewsAround() {
+  std::vector<Rigid3> views;
+  for (int a = 0; a < 8; ++a) {
+    for (double tilt : {-0.9, 0.0, 0.9}) {
+      const Rigid3 turn =
+          Rigid3::FromAxisAngle({1, 0, 0}, tilt) * Rigid3::FromAxisAngle({0, 1, 0}, a * M_PI / 4);
+      views.push_back(Rigid3::Translation({0, 0, 600}) * turn);
+    }
+  }
+  views.push_back(Rigid3::Translation({0, 0, 600}) * Rigid3::FromAxisAngle({1, 0, 0}, M_PI / 2));
+  views.push_back(Rigid3::Translation({0, 0, 600}) * Rigid3::FromAxisAngle({1, 0, 0}, -M_PI / 2));
+  return views;
+}
+
+TEST(TsdfVolumeTest, ASphereSeenFromAllAroundMeshesClosedAtItsRadiusWithItsColours) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  TsdfVolume volume;
+  EXPECT_NEAR(volume.voxel_mm(), 350.0 / 256, 1e-12);
+  for (const Rigid3& view : ViewsAround()) {
+    const Frame frame = RenderSphere(intrinsics, view);
+    EXPECT_GT(volume.Integrate(frame, {}, intrinsics, view), 1000);
+  }
+  // Only a band around the surface is touched: a shell of ±4 voxels, far from the whole cube.
+  const double shell =
+      4 * M_PI * kRadius * kRadius * 2 * volume.truncation_mm() / std::pow(volume.voxel_mm(), 3);
+  EXPECT_LT(volume.ObservedVoxels(), 2.0 * shell);
+  EXPECT_GT(volume.ObservedVoxels(), 0.5 * shell);
+
+  const TriangleMesh mesh = volume.ExtractMesh();
+  ASSERT_GT(mesh.faces.size(), 1000u);
+  EXPECT_TRUE(mesh.IsWatertight());
+  double sum = 0, worst = 0;
+  int wrong_colour = 0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const double error = mesh.vertices[i].cast<double>().norm() - kRadius;
+    sum += error, worst = std::max(worst, std::abs(error));
+    const bool red = mesh.colors[i][0] > mesh.colors[i][1];
+    // Away from the seam between the halves, each keeps its colour.
+    if (std::abs(mesh.vertices[i].x()) > 3 && red != (mesh.vertices[i].x() > 0)) ++wrong_colour;
+  }
+  const double mean = sum / mesh.vertices.size();
+  std::printf(
+      "%zu vertices, %zu faces: radius error mean %.3f mm, worst %.3f mm; volume %.0f mm³ "
+      "(true %.0f)\n",
+      mesh.vertices.size(), mesh.faces.size(), mean, worst, mesh.Volume(),
+      4.0 / 3 * M_PI * std::pow(kRadius, 3));
+  // Measured: mean 0.08 mm, worst 0.62 mm, volume +0.7 %.
+  EXPECT_LT(std::abs(mean), 0.5);
+  EXPECT_LT(worst, 1.0);
+  EXPECT_EQ(wrong_colour, 0);
+  EXPECT_NEAR(mesh.Volume(), 4.0 / 3 * M_PI * std::pow(kRadius, 3),
+              0.02 * 4.0 / 3 * M_PI * std::pow(kRadius, 3));
+  // Outward normals.
+  int inward = 0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i)
+    inward += mesh.normals[i].dot(mesh.vertices[i]) < 0;
+  EXPECT_EQ(inward, 0);
+}
+
+TEST(TsdfVolumeTest, RaycastSeesTheSphereFromANewView) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  TsdfVolume volume;
+  for (const Rigid3& view : ViewsAround()) {
+    volume.Integrate(RenderSphere(intrinsics, view), {}, intrinsics, view);
+  }
+  const Rigid3 view =
+      Rigid3::Translation({10, -5, 580}) * Rigid3::FromAxisAngle(Eigen::Vector3d(1, 2, 3), 0.4);
+  const RaycastImage image = volume.Raycast(intrinsics, view);
+  const Frame truth = RenderSphere(intrinsics, view);
+  int hits = 0, misses = 0, compared = 0;
+  double worst = 0, sum = 0;
+  for (int pixel = 0; pixel < truth.PixelCount(); ++pixel) {
+    const bool seen = truth.depth_mm[pixel] != 0;
+    if (!seen) {
+      misses += image.depth_mm[pixel] != 0;
+      continue;
+    }
+    if (image.depth_mm[pixel] == 0) continue;
+    ++hits;
+    // Against the exact depth of the sphere along this pixel's ray.
+    const int u = pixel % truth.width, v = pixel / truth.width;
+    const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
+    const Eigen::Vector3d centre = view.translation();
+    const double b = ray.dot(centre), c = centre.squaredNorm() - kRadius * kRadius;
+    if (b * b - c < 0) continue;
+    const Eigen::Vector3d hit = (b - std::sqrt(b * b - c)) * ray;
+    // Away from the rim, where a pixel grazes the surface.
+    if ((hit - centre).normalized().dot(-ray) < 0.3) continue;
+    worst = std::max(worst, std::abs(image.depth_mm[pixel] - hit.z()));
+    sum += std::abs(image.depth_mm[pixel] - hit.z()), ++compared;
+    EXPECT_GT(image.normals[pixel].dot((hit - centre).normalized().cast<float>()), 0.95f);
+  }
+  int seen = 0;
+  for (std::uint16_t z : truth.depth_mm) seen += z != 0;
+  std::printf(
+      "raycast: %d of %d sphere pixels hit, %d outside; depth error mean %.3f mm, worst "
+      "%.3f mm\n",
+      hits, seen, misses, sum / compared, worst);
+  // Measured: every pixel hit, 17 rim pixels outside; mean 0.16 mm, worst 0.80 mm (voxels are
+  // 1.37 mm, the integrated depths whole millimetres).
+  EXPECT_GT(hits, 0.97 * seen);
+  EXPECT_LT(misses, 0.02 * seen);
+  EXPECT_LT(sum / compared, 0.3);
+  EXPECT_LT(worst, 1.0);
+}
+
+TEST(TsdfVolumeTest, MaskedPixelsAloneAreIntegratedAndBadInputIsRefused) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  const Rigid3 view = Rigid3::Translation({0, 0, 600});
+  const Frame frame = RenderSphere(intrinsics, view);
+  TsdfVolume volume;
+  std::vector<std::uint8_t> nothing(frame.depth_mm.size(), 0);
+  EXPECT_EQ(volume.Integrate(frame, nothing, intrinsics, view), 0);
+  EXPECT_EQ(volume.ObservedVoxels(), 0);
+  EXPECT_TRUE(volume.ExtractMesh().Empty());
+  EXPECT_THROW(volume.Integrate(frame, std::vector<std::uint8_t>(10), intrinsics, view),
+               std::invalid_argument);
+  TsdfOptions bad;
+  bad.resolution = 2;
+  EXPECT_THROW(TsdfVolume{bad}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ihs::fusion
