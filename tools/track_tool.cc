@@ -131,8 +131,8 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   double total_ms = 0;
   for (double ms : milliseconds) total_ms += ms;
   nlohmann::json summary = {{"frames", index},
-                             {"hand_scale", tracker.scale() * (hand_scale > 0 ? hand_scale : 1.0)},
-                             {"hand_scale_estimated", options.scale_frames > 0},
+                            {"hand_scale", tracker.scale() * (hand_scale > 0 ? hand_scale : 1.0)},
+                            {"hand_scale_estimated", options.scale_frames > 0},
                             {"status_counts", counts},
                             {"ms_mean", total_ms / index},
                             {"ms_p95", Quantile(milliseconds, 0.95)},
@@ -192,7 +192,8 @@ int main(int argc, char** argv) {
   app.add_option("--template", template_name, "procedural, or the real hand data folder")
       ->capture_default_str();
   app.add_option("--hand-scale", hand_scale,
-                 "scale of the template (default: the procedural one estimated over the first frames, a scanned one 1)")
+                 "scale of the template (default: the procedural one estimated over the first "
+                 "frames, a scanned one 1)")
       ->check(CLI::Range(0.5, 2.0));
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");

@@ -464,8 +464,7 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     // The data → model pairs also as points: a plane lets a finger slide along its axis.
     if (options_.data_point_weight > 0) {
       for (const PlanePair& pair : data_pairs) {
-        model_pairs.push_back(
-            {pair.vertex, pair.target, options_.data_point_weight * pair.weight});
+        model_pairs.push_back({pair.vertex, pair.target, options_.data_point_weight * pair.weight});
       }
     }
 
@@ -489,13 +488,12 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
 
     PoseParameters parameters(pose);
     ceres::Problem problem;
-    problem.AddResidualBlock(
-        new HandFitCost(model_, parameters.reference_rotation(), intrinsics_,
-                        {std::move(model_pairs), std::move(data_pairs), silhouette_pairs(),
-                         std::move(collisions)},
-                        options_.collision_weight, options_.limit_weight, options_.prior_weight,
-                        prior),
-        nullptr, parameters.values().data());
+    problem.AddResidualBlock(new HandFitCost(model_, parameters.reference_rotation(), intrinsics_,
+                                             {std::move(model_pairs), std::move(data_pairs),
+                                              silhouette_pairs(), std::move(collisions)},
+                                             options_.collision_weight, options_.limit_weight,
+                                             options_.prior_weight, prior),
+                             nullptr, parameters.values().data());
     ceres::Solver::Options solver;
     // A few hundred residual rows, ≈ 30 parameters: the normal equations are small and cheap.
     solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;

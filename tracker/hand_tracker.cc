@@ -96,7 +96,8 @@ HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
   if (options_.scale_frames > 0 && options_.scale_range > 0) {
     HandFitOptions fit = FitOptions(options_);
     fit.outer_iterations = std::min(fit.outer_iterations, 3);
-    const int steps = static_cast<int>(std::floor(options_.scale_range / options_.scale_step + 1e-6));
+    const int steps =
+        static_cast<int>(std::floor(options_.scale_range / options_.scale_step + 1e-6));
     for (int k = -steps; k <= steps; ++k) {
       auto candidate = std::make_unique<ScaleCandidate>();
       candidate->scale = 1.0 + k * options_.scale_step;
@@ -123,18 +124,16 @@ HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) con
   for (const auto& joint : joints) centre += joint;
   centre = base_model_.model_from_bone_rest[0].Inverse() * Eigen::Vector3d(centre / joints.size());
   HandPose out = pose;
-  out.cam_from_root =
-      Rigid3(pose.cam_from_root.rotation(),
-             pose.cam_from_root.translation() +
-                 pose.cam_from_root.rotation() * ((from - to) * centre));
+  out.cam_from_root = Rigid3(
+      pose.cam_from_root.rotation(),
+      pose.cam_from_root.translation() + pose.cam_from_root.rotation() * ((from - to) * centre));
   return out;
 }
 
 void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& frame) {
   for (auto& candidate : scale_candidates_) {
     const HandFitResult fit = candidate->fitter->Fit(
-        segmentation.hand_points, &frame, Rescaled(pose_, scale_, candidate->scale),
-        &segmentation);
+        segmentation.hand_points, &frame, Rescaled(pose_, scale_, candidate->scale), &segmentation);
     // How far the hand points are from the model, and the model's visible points from them.
     candidate->score += fit.data_error_mm + fit.model_error_mm;
   }
@@ -153,8 +152,8 @@ void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& f
   }
   std::string scores;
   for (const auto& candidate : scale_candidates_) {
-    scores += fmt::format(" {:.2f}: {:.2f}", candidate->scale,
-                          candidate->score / options_.scale_frames);
+    scores +=
+        fmt::format(" {:.2f}: {:.2f}", candidate->scale, candidate->score / options_.scale_frames);
   }
   spdlog::debug("hand scale {:.3f} from mean scores{}", scale, scores);
   scale_candidates_.clear();

@@ -226,8 +226,8 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
                  options.palm_width_mm / options.palm_base_width_mm},
                 segments * 2, palm_weights);
   // The wrist: a shorter, flat capsule on the root bone.
-  AppendCapsule(model, model.model_from_bone_rest[0], wrist, options.wrist_width_mm / 2 * s,
-                10 * s, {options.wrist_thickness_mm / options.wrist_width_mm, 2.0}, segments * 2,
+  AppendCapsule(model, model.model_from_bone_rest[0], wrist, options.wrist_width_mm / 2 * s, 10 * s,
+                {options.wrist_thickness_mm / options.wrist_width_mm, 2.0}, segments * 2,
                 JointBlendWeights(model, 0));
   // Fingers and thumb: round capsules on the phalanges and the thumb's metacarpal.
   // A fingertip's skin ends just beyond its bone's end point, as on a real hand (the scanned
@@ -240,8 +240,8 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     if (metacarpal && finger < 4) continue;  // Inside the palm.
     const bool distal = std::find(ends.begin(), ends.end(), bone) != ends.end();
     const bool proximal = model.bones[model.bones[bone].parent].name.ends_with("Hand");
-    const double taper = distal ? options.distal_taper
-                                : (proximal ? 1.0 : 0.5 * (1.0 + options.distal_taper));
+    const double taper =
+        distal ? options.distal_taper : (proximal ? 1.0 : 0.5 * (1.0 + options.distal_taper));
     const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : taper);
     double length = model.bones[bone].length_mm;
     if (distal) length = std::max(0.3 * length, length - radius + kTipBeyondEndMm * s);
