@@ -1,12 +1,12 @@
 #include "tracker/hand_fit.h"
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 
 #include "core/check.h"
+#include "core/rigid_fit.h"
 #include "tracker/hand_fit_cost.h"
 #include "tracker/point_kd_tree.h"
 
@@ -606,20 +606,8 @@ HandPose FitPoseToJoints(const HandModel& model, const std::vector<Eigen::Vector
       "FitPoseToJoints needs " << model.bones.size() + 1 << " joints, got " << joints_mm.size());
   // Start: the rest pose placed by the best rigid fit of its joints to the targets.
   const HandPose rest = HandPose::Rest(model);
-  const std::vector<Eigen::Vector3d> rest_joints =
-      model.JointPositions(ForwardKinematics(model, rest));
-  Eigen::Vector3d mean_rest = Eigen::Vector3d::Zero(), mean_target = Eigen::Vector3d::Zero();
-  for (size_t j = 0; j < joints_mm.size(); ++j)
-    mean_rest += rest_joints[j], mean_target += joints_mm[j];
-  mean_rest /= joints_mm.size(), mean_target /= joints_mm.size();
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (size_t j = 0; j < joints_mm.size(); ++j)
-    covariance += (joints_mm[j] - mean_target) * (rest_joints[j] - mean_rest).transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d flip = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) flip(2, 2) = -1;
-  const Eigen::Matrix3d rotation = svd.matrixU() * flip * svd.matrixV().transpose();
-  const Rigid3 cam_from_model(rotation, mean_target - rotation * mean_rest);
+  const Rigid3 cam_from_model =
+      FitRigidTransform(model.JointPositions(ForwardKinematics(model, rest)), joints_mm);
   HandPose start = HandPose::Rest(model, cam_from_model);
 
   HandPose pose = start;

@@ -7,9 +7,9 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/rigid_fit.h"
 #include "tools/synth/hand_object.h"
 #include "tools/synth/least_squares.h"
-#include "tools/synth/rigid_fit.h"
 #include "tracker/hand_pose.h"
 
 namespace ihs::synth {

@@ -1,0 +1,115 @@
+#include "fusion/pairwise_registration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "core/check.h"
+#include "core/rigid_fit.h"
+
+namespace ihs::fusion {
+
+void PairwiseOptions::Check() const {
+  IHS_CHECK_ARG(contact_weight >= 0, "pairwise.contact_weight must be >= 0");
+  IHS_CHECK_ARG(visual_weight >= 0, "pairwise.visual_weight must be >= 0");
+  IHS_CHECK_ARG(contact_weight > 0 || visual_weight > 0,
+                "pairwise.contact_weight and visual_weight cannot both be 0");
+  IHS_CHECK_ARG(ransac_iterations >= 1, "pairwise.ransac_iterations must be >= 1");
+  IHS_CHECK_ARG(inlier_mm > 0, "pairwise.inlier_mm must be positive");
+  IHS_CHECK_ARG(min_visual_inliers >= 3, "pairwise.min_visual_inliers must be >= 3");
+  IHS_CHECK_ARG(min_contacts >= 3, "pairwise.min_contacts must be >= 3");
+}
+
+namespace {
+
+// The largest set of visual pairs consistent with one rigid motion (hypotheses from three
+// pairs), or none when it has fewer than `min_inliers`.
+std::vector<PointMatch> RansacInliers(const std::vector<PointMatch>& matches,
+                                      const PairwiseOptions& options) {
+  const int n = static_cast<int>(matches.size());
+  if (n < options.min_visual_inliers) return {};
+  std::mt19937 rng(options.seed);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  const double inlier_sq = options.inlier_mm * options.inlier_mm;
+  std::vector<int> best;
+  for (int iteration = 0; iteration < options.ransac_iterations; ++iteration) {
+    const int a = pick(rng), b = pick(rng), c = pick(rng);
+    const Eigen::Vector3d& pa = matches[a].previous;
+    const Eigen::Vector3d& pb = matches[b].previous;
+    const Eigen::Vector3d& pc = matches[c].previous;
+    // Three distinct, non-collinear points whose distances agree in both frames.
+    if ((pb - pa).cross(pc - pa).norm() < 25.0) continue;
+    bool rigid = true;
+    for (auto [i, j] : {std::pair{a, b}, std::pair{b, c}, std::pair{a, c}}) {
+      const double d0 = (matches[i].previous - matches[j].previous).norm();
+      const double d1 = (matches[i].current - matches[j].current).norm();
+      rigid = rigid && std::abs(d0 - d1) < 2 * options.inlier_mm;
+    }
+    if (!rigid) continue;
+    const Rigid3 motion = FitRigidTransform(
+        {pa, pb, pc}, {matches[a].current, matches[b].current, matches[c].current});
+    std::vector<int> inliers;
+    for (int i = 0; i < n; ++i) {
+      if ((motion * matches[i].previous - matches[i].current).squaredNorm() < inlier_sq)
+        inliers.push_back(i);
+    }
+    if (inliers.size() > best.size()) best = std::move(inliers);
+  }
+  if (static_cast<int>(best.size()) < options.min_visual_inliers) return {};
+  // Refit on the inliers and gather them once more.
+  std::vector<Eigen::Vector3d> from, to;
+  for (int i : best) from.push_back(matches[i].previous), to.push_back(matches[i].current);
+  const Rigid3 motion = FitRigidTransform(from, to);
+  std::vector<PointMatch> inliers;
+  for (const PointMatch& m : matches) {
+    if ((motion * m.previous - m.current).squaredNorm() < inlier_sq) inliers.push_back(m);
+  }
+  return static_cast<int>(inliers.size()) >= options.min_visual_inliers ? inliers
+                                                                        : std::vector<PointMatch>{};
+}
+
+}  // namespace
+
+PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& options) {
+  options.Check();
+  PairwiseResult result;
+  std::vector<PointMatch> visual;
+  if (options.visual_weight > 0) {
+    visual = input.features_2d;
+    visual.insert(visual.end(), input.features_3d.begin(), input.features_3d.end());
+    visual = RansacInliers(visual, options);
+  }
+  const bool use_contacts = options.contact_weight > 0 &&
+                            (static_cast<int>(input.contacts.size()) >= options.min_contacts ||
+                             (!visual.empty() && !input.contacts.empty()));
+  if (visual.empty() && !use_contacts) {
+    result.reason = "too few correspondences: " + std::to_string(input.features_2d.size()) +
+                    " 2D and " + std::to_string(input.features_3d.size()) +
+                    " 3D feature matches (no consistent set of " +
+                    std::to_string(options.min_visual_inliers) + "), " +
+                    std::to_string(input.contacts.size()) + " contacts";
+    return result;
+  }
+  std::vector<Eigen::Vector3d> from, to;
+  std::vector<double> weights;
+  for (const PointMatch& m : visual) {
+    from.push_back(m.previous), to.push_back(m.current), weights.push_back(options.visual_weight);
+  }
+  if (use_contacts) {
+    for (const PointMatch& m : input.contacts) {
+      from.push_back(m.previous), to.push_back(m.current);
+      weights.push_back(options.contact_weight);
+    }
+  }
+  result.current_from_previous = FitRigidTransform(from, to, weights);
+  double sum = 0;
+  for (size_t i = 0; i < from.size(); ++i)
+    sum += (result.current_from_previous * from[i] - to[i]).squaredNorm();
+  result.rms_mm = std::sqrt(sum / from.size());
+  result.visual_inliers = static_cast<int>(visual.size());
+  result.contacts = use_contacts ? static_cast<int>(input.contacts.size()) : 0;
+  result.ok = true;
+  return result;
+}
+
+}  // namespace ihs::fusion

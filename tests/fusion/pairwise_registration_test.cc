@@ -1,0 +1,108 @@
+// The pairwise registration: a known object motion from noisy feature matches with outliers and
+// from contacts, each set alone, and a frame pair with nothing to go on.
+
+#include "fusion/pairwise_registration.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include "tests/test_util.h"
+
+namespace ihs::fusion {
+namespace {
+
+// The largest distance between where two motions put the points of a 40 mm ball at 600 mm.
+double MotionError(const Rigid3& a, const Rigid3& b) {
+  double worst = 0;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        const Eigen::Vector3d p =
+            Eigen::Vector3d(0, 0, 600) + 40.0 / std::sqrt(3) * Eigen::Vector3d(x, y, z);
+        worst = std::max(worst, (a * p - b * p).norm());
+      }
+  return worst;
+}
+
+struct Scene {
+  Rigid3 truth;
+  PairwiseInput input;
+};
+
+// Points on a 40 mm ball at 600 mm moved by a small motion about its centre; `outliers` of the
+// visual matches are wrong.
+Scene MakeScene(std::mt19937& rng, int matches_2d, int matches_3d, int contacts, double outliers) {
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::normal_distribution<double> noise(0, 1);
+  const Eigen::Vector3d centre(10, -20, 600);
+  Scene scene;
+  scene.truth = Rigid3::Translation(centre + Eigen::Vector3d(6, -3, 4)) *
+                Rigid3::FromAxisAngle({0.2, 1, 0.1}, 0.09) * Rigid3::Translation(-centre);
+  auto point = [&]() -> Eigen::Vector3d {
+    return centre + 40 * Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+  };
+  auto add = [&](std::vector<PointMatch>& set, int count, double sigma, double wrong) {
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Vector3d p = point();
+      Eigen::Vector3d q =
+          scene.truth * p + sigma * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+      if (unit(rng) * 0.5 + 0.5 < wrong) q = point();  // A wrong match: another point of the ball.
+      set.push_back({p, q});
+    }
+  };
+  add(scene.input.features_2d, matches_2d, 1.0, outliers);
+  add(scene.input.features_3d, matches_3d, 1.5, outliers);
+  add(scene.input.contacts, contacts, 0.5, 0.0);
+  return scene;
+}
+
+TEST(PairwiseRegistrationTest, RecoversAKnownMotionFromNoisyMatchesWithOutliersAndContacts) {
+  std::mt19937 rng = test::Rng();
+  const Scene scene = MakeScene(rng, 80, 40, 30, 0.35);
+  const PairwiseResult result = RegisterPair(scene.input);
+  ASSERT_TRUE(result.ok) << result.reason;
+  std::printf("%d visual inliers of 120, %d contacts: motion error %.3f mm, rms %.2f mm\n",
+              result.visual_inliers, result.contacts,
+              MotionError(result.current_from_previous, scene.truth), result.rms_mm);
+  EXPECT_GT(result.visual_inliers, 60);
+  EXPECT_LT(result.visual_inliers, 95);  // The outliers are out.
+  EXPECT_EQ(result.contacts, 30);
+  EXPECT_LT(MotionError(result.current_from_previous, scene.truth), 0.6);
+  EXPECT_LT(result.rms_mm, 3.0);
+}
+
+TEST(PairwiseRegistrationTest, EachSetAloneStillGivesTheMotion) {
+  std::mt19937 rng = test::Rng(1);
+  const Scene scene = MakeScene(rng, 60, 0, 12, 0.3);
+  PairwiseOptions visual_only;
+  visual_only.contact_weight = 0;  // The paper's γt = 0 baseline.
+  const PairwiseResult visual = RegisterPair(scene.input, visual_only);
+  ASSERT_TRUE(visual.ok) << visual.reason;
+  EXPECT_EQ(visual.contacts, 0);
+  EXPECT_LT(MotionError(visual.current_from_previous, scene.truth), 1.0);
+
+  PairwiseInput contacts_only = scene.input;
+  contacts_only.features_2d.clear();
+  const PairwiseResult contacts = RegisterPair(contacts_only);
+  ASSERT_TRUE(contacts.ok) << contacts.reason;
+  EXPECT_EQ(contacts.visual_inliers, 0);
+  EXPECT_LT(MotionError(contacts.current_from_previous, scene.truth), 1.0);
+}
+
+TEST(PairwiseRegistrationTest, NothingToGoOnIsASkippedFrameWithItsReason) {
+  const PairwiseResult none = RegisterPair({});
+  EXPECT_FALSE(none.ok);
+  EXPECT_NE(none.reason.find("too few correspondences"), std::string::npos) << none.reason;
+  // Two contacts and a handful of inconsistent matches are not enough either.
+  std::mt19937 rng = test::Rng(2);
+  Scene scene = MakeScene(rng, 8, 0, 2, 1.0);
+  EXPECT_FALSE(RegisterPair(scene.input).ok);
+  PairwiseOptions bad;
+  bad.contact_weight = -1;
+  EXPECT_THROW(RegisterPair(scene.input, bad), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ihs::fusion
