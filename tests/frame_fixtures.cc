@@ -1,5 +1,7 @@
 #include "tests/frame_fixtures.h"
 
+#include <cmath>
+
 namespace ihs::test {
 
 Frame MakePatternFrame(std::int64_t index, int width, int height) {
@@ -25,6 +27,52 @@ std::vector<Frame> MakePatternFrames(int count, int width, int height) {
   std::vector<Frame> frames;
   for (int i = 0; i < count; ++i) frames.push_back(MakePatternFrame(i, width, height));
   return frames;
+}
+
+namespace {
+// The ray parameter (camera frame, unit ray) where pixel (u, v)'s ray first meets the ellipsoid,
+// or a negative value on a miss.
+double EllipsoidHit(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object,
+                    const Eigen::Vector3d& semi_axes_mm, double u, double v,
+                    Eigen::Vector3d* ray_out) {
+  const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
+  const Rigid3 object_from_cam = cam_from_object.Inverse();
+  // In the frame where the ellipsoid is the unit sphere.
+  const Eigen::Vector3d origin = object_from_cam.translation().cwiseQuotient(semi_axes_mm);
+  const Eigen::Vector3d direction = object_from_cam.RotateVector(ray).cwiseQuotient(semi_axes_mm);
+  const double a = direction.squaredNorm(), b = origin.dot(direction), c = origin.squaredNorm() - 1;
+  const double discriminant = b * b - a * c;
+  if (ray_out) *ray_out = ray;
+  if (discriminant < 0) return -1;
+  return (-b - std::sqrt(discriminant)) / a;
+}
+}  // namespace
+
+double EllipsoidDepth(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object,
+                      const Eigen::Vector3d& semi_axes_mm, double u, double v) {
+  Eigen::Vector3d ray;
+  const double t = EllipsoidHit(intrinsics, cam_from_object, semi_axes_mm, u, v, &ray);
+  return t > 0 ? t * ray.z() : 0.0;
+}
+
+Frame RenderEllipsoid(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object,
+                      const Eigen::Vector3d& semi_axes_mm) {
+  Frame frame = Frame::Blank(intrinsics.width, intrinsics.height, true);
+  const Rigid3 object_from_cam = cam_from_object.Inverse();
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      Eigen::Vector3d ray;
+      const double t = EllipsoidHit(intrinsics, cam_from_object, semi_axes_mm, u, v, &ray);
+      if (t <= 0) continue;
+      const int pixel = v * frame.width + u;
+      frame.depth_mm[pixel] = static_cast<std::uint16_t>(std::lround(t * ray.z()));
+      const bool red = (object_from_cam * Eigen::Vector3d(t * ray)).x() > 0;
+      frame.rgb[3 * pixel] = red ? 220 : 30;
+      frame.rgb[3 * pixel + 1] = red ? 30 : 200;
+      frame.rgb[3 * pixel + 2] = 40;
+    }
+  }
+  return frame;
 }
 
 }  // namespace ihs::test

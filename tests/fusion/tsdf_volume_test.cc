@@ -9,33 +9,16 @@
 #include <cstdio>
 #include <vector>
 
+#include "tests/frame_fixtures.h"
+
 namespace ihs::fusion {
 namespace {
 
 constexpr double kRadius = 35.0;  // The paper's sphere: Ø70 mm.
 
-// Depth (mm, rounded as a sensor would) and colour of a sphere of kRadius at the volume's origin
-// seen from `cam_from_volume`: red where the volume frame's x > 0, green elsewhere.
+// The sphere seen from `cam_from_volume`, red where the volume frame's x > 0, green elsewhere.
 Frame RenderSphere(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume) {
-  Frame frame = Frame::Blank(intrinsics.width, intrinsics.height, true);
-  const Eigen::Vector3d centre = cam_from_volume.translation();
-  const Rigid3 volume_from_cam = cam_from_volume.Inverse();
-  for (int v = 0; v < frame.height; ++v) {
-    for (int u = 0; u < frame.width; ++u) {
-      const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
-      const double b = ray.dot(centre), c = centre.squaredNorm() - kRadius * kRadius;
-      const double discriminant = b * b - c;
-      if (discriminant < 0) continue;
-      const Eigen::Vector3d hit = (b - std::sqrt(discriminant)) * ray;
-      const int pixel = v * frame.width + u;
-      frame.depth_mm[pixel] = static_cast<std::uint16_t>(std::lround(hit.z()));
-      const bool red = (volume_from_cam * hit).x() > 0;
-      frame.rgb[3 * pixel] = red ? 220 : 30;
-      frame.rgb[3 * pixel + 1] = red ? 30 : 200;
-      frame.rgb[3 * pixel + 2] = 40;
-    }
-  }
-  return frame;
+  return test::RenderEllipsoid(intrinsics, cam_from_volume, Eigen::Vector3d::Constant(kRadius));
 }
 
 // Views from all around: the sphere 600 mm in front of the camera, turned about two axes.
@@ -122,9 +105,10 @@ TEST(TsdfVolumeTest, RaycastSeesTheSphereFromANewView) {
     const int u = pixel % truth.width, v = pixel / truth.width;
     const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
     const Eigen::Vector3d centre = view.translation();
-    const double b = ray.dot(centre), c = centre.squaredNorm() - kRadius * kRadius;
-    if (b * b - c < 0) continue;
-    const Eigen::Vector3d hit = (b - std::sqrt(b * b - c)) * ray;
+    const double depth =
+        test::EllipsoidDepth(intrinsics, view, Eigen::Vector3d::Constant(kRadius), u, v);
+    if (depth <= 0) continue;
+    const Eigen::Vector3d hit = depth / ray.z() * ray;
     // Away from the rim, where a pixel grazes the surface.
     if ((hit - centre).normalized().dot(-ray) < 0.3) continue;
     worst = std::max(worst, std::abs(image.depth_mm[pixel] - hit.z()));

@@ -1,0 +1,83 @@
+#include "fusion/icp.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+
+#include "core/check.h"
+
+namespace ihs::fusion {
+
+void IcpOptions::Check() const {
+  IHS_CHECK_ARG(iterations >= 1, "icp.iterations must be >= 1");
+  IHS_CHECK_ARG(max_distance_mm > 0, "icp.max_distance_mm must be positive");
+  IHS_CHECK_ARG(min_inlier_fraction >= 0 && min_inlier_fraction <= 1,
+                "icp.min_inlier_fraction must be in [0, 1]");
+}
+
+IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
+                       const CameraIntrinsics& intrinsics, const Rigid3& predicted,
+                       const IcpOptions& options) {
+  options.Check();
+  IHS_CHECK_ARG(model.width == intrinsics.width && model.height == intrinsics.height,
+                "the raycast is " << model.width << "x" << model.height << ", the camera "
+                                  << intrinsics.width << "x" << intrinsics.height);
+  IcpResult result;
+  result.cam_from_volume = predicted;
+  const int needed =
+      std::max(50, static_cast<int>(std::ceil(options.min_inlier_fraction * points.size())));
+  // predicted_from_current: takes the current camera's points to where the predicted camera
+  // sees the same surface (the model's raycast).
+  Rigid3 correction;
+  const double max_sq = options.max_distance_mm * options.max_distance_mm;
+  double rms = 0;
+  int inliers = 0;
+  for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    double sum_sq = 0;
+    inliers = 0;
+    for (const Eigen::Vector3f& point : points) {
+      const Eigen::Vector3d p = correction * Eigen::Vector3d(point.cast<double>());
+      if (p.z() <= 0) continue;
+      const Eigen::Vector2d pixel = intrinsics.Project(p);
+      const int u = static_cast<int>(std::lround(pixel.x()));
+      const int v = static_cast<int>(std::lround(pixel.y()));
+      if (u < 0 || v < 0 || u >= model.width || v >= model.height) continue;
+      const size_t index = static_cast<size_t>(v) * model.width + u;
+      const float depth = model.depth_mm[index];
+      const Eigen::Vector3d normal = model.normals[index].cast<double>();
+      if (depth <= 0 || normal.squaredNorm() < 0.5) continue;
+      const Eigen::Vector3d target = intrinsics.BackProject(u, v, depth);
+      if ((p - target).squaredNorm() > max_sq) continue;
+      const double residual = normal.dot(p - target);
+      // d(residual)/d(ω, t) for p ← exp(ω)·p + t: (p × n, n).
+      Eigen::Matrix<double, 6, 1> row;
+      row << p.cross(normal), normal;
+      normal_matrix += row * row.transpose();
+      rhs -= row * residual;
+      sum_sq += residual * residual;
+      ++inliers;
+    }
+    rms = inliers > 0 ? std::sqrt(sum_sq / inliers) : 0;
+    if (inliers < 6) break;
+    const Eigen::Matrix<double, 6, 1> step = normal_matrix.ldlt().solve(rhs);
+    if (!step.allFinite()) break;
+    correction = Rigid3::FromRotationVector(step.head<3>(), step.tail<3>()) * correction;
+    result.iterations = iteration + 1;
+    if (step.tail<3>().norm() + 50.0 * step.head<3>().norm() < 0.01) break;
+  }
+  result.inliers = inliers;
+  result.rms_mm = rms;
+  // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.
+  result.cam_from_volume = correction.Inverse() * predicted;
+  if (inliers < needed) {
+    result.reason = "ICP: " + std::to_string(inliers) + " of " + std::to_string(points.size()) +
+                    " points pair with the model (need " + std::to_string(needed) + ")";
+    return result;
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace ihs::fusion

@@ -1,0 +1,49 @@
+#pragma once
+// Refinement of the object's pose against the model, as KinectFusion does it: point-to-plane ICP
+// between the current frame's object points and a raycast of the TSDF at the predicted pose,
+// with projective data association (a point is paired with the model surface seen through its
+// pixel). The cost per frame does not grow with the scan.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/rigid3.h"
+#include "fusion/tsdf_volume.h"
+
+namespace ihs::fusion {
+
+/// Options of the ICP refinement (defaults: the paper's 5 mm correspondences).
+struct IcpOptions {
+  /// Gauss–Newton iterations at most; it stops earlier once a step moves less than 0.01 mm.
+  int iterations = 15;
+  /// Pairs farther apart than this are not used, mm (paper: 5).
+  double max_distance_mm = 5.0;
+  /// Fewer pairs than this share of the points (or than 50) and the result is not trusted.
+  double min_inlier_fraction = 0.2;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// The refined pose and how well it fits.
+struct IcpResult {
+  bool ok = false;
+  /// Why the result is not trusted (empty when ok).
+  std::string reason;
+  /// The object's pose in the current camera: `predicted` corrected.
+  Rigid3 cam_from_volume;
+  int inliers = 0;
+  /// Root mean square point-to-plane distance of the final pairs, mm.
+  double rms_mm = 0;
+  int iterations = 0;
+};
+
+/// Aligns `points` (the current frame's object points, camera frame, mm) to `model` (the TSDF
+/// raycast at `predicted`, the predicted cam_from_volume) seen by a camera with `intrinsics`.
+IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
+                       const CameraIntrinsics& intrinsics, const Rigid3& predicted,
+                       const IcpOptions& options = {});
+
+}  // namespace ihs::fusion
