@@ -17,7 +17,7 @@ void IcpOptions::Check() const {
 
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
-                       const IcpOptions& options) {
+                       const IcpOptions& options, const std::vector<IcpAnchor>& anchors) {
   options.Check();
   IHS_CHECK_ARG(model.width == intrinsics.width && model.height == intrinsics.height,
                 "the raycast is " << model.width << "x" << model.height << ", the camera "
@@ -60,7 +60,21 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       ++inliers;
     }
     rms = inliers > 0 ? std::sqrt(sum_sq / inliers) : 0;
+    for (const IcpAnchor& anchor : anchors) {
+      const Eigen::Vector3d p = correction * anchor.current;
+      const Eigen::Vector3d residual = p - anchor.target;
+      for (int k = 0; k < 3; ++k) {
+        Eigen::Matrix<double, 6, 1> row;
+        row << p.cross(Eigen::Vector3d::Unit(k)), Eigen::Vector3d::Unit(k);
+        normal_matrix += anchor.weight * row * row.transpose();
+        rhs -= anchor.weight * row * residual[k];
+      }
+    }
     if (inliers < 6) break;
+    // A little (Marquardt) damping: directions the surface does not constrain (a sphere's
+    // turn, a cylinder's slide) stay where the prediction put them instead of moving at random.
+    normal_matrix.diagonal() *= 1.0 + 1e-4;
+    normal_matrix.diagonal().array() += 1e-9;
     const Eigen::Matrix<double, 6, 1> step = normal_matrix.ldlt().solve(rhs);
     if (!step.allFinite()) break;
     correction = Rigid3::FromRotationVector(step.head<3>(), step.tail<3>()) * correction;

@@ -40,10 +40,20 @@ struct IcpResult {
   int iterations = 0;
 };
 
+/// A point of the current frame (camera frame, mm) that must land at `target`, where the
+/// prediction puts it (e.g. a fingertip contact moved by the pairwise registration), weighted
+/// against one point-to-plane pair. Anchors hold what the surface alone cannot: a sphere's turn.
+struct IcpAnchor {
+  Eigen::Vector3d current;
+  Eigen::Vector3d target;
+  double weight = 1.0;
+};
+
 /// Aligns `points` (the current frame's object points, camera frame, mm) to `model` (the TSDF
-/// raycast at `predicted`, the predicted cam_from_volume) seen by a camera with `intrinsics`.
+/// raycast at `predicted`, the predicted cam_from_volume) seen by a camera with `intrinsics`,
+/// together with `anchors`.
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
-                       const IcpOptions& options = {});
+                       const IcpOptions& options = {}, const std::vector<IcpAnchor>& anchors = {});
 
 }  // namespace ihs::fusion

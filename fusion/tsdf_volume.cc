@@ -151,8 +151,8 @@ bool TsdfVolume::SignedDistance(const Eigen::Vector3f& point, float* distance_mm
   return true;
 }
 
-RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics,
-                                 const Rigid3& cam_from_volume) const {
+RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume,
+                                 const std::array<int, 4>& roi) const {
   RaycastImage image;
   image.width = intrinsics.width;
   image.height = intrinsics.height;
@@ -166,8 +166,12 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics,
   const Eigen::Matrix3f to_cam = cam_from_volume.rotation().cast<float>();
   const float half = static_cast<float>(0.5 * options_.size_mm);
   const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
-  for (int v = 0; v < image.height; ++v) {
-    for (int u = 0; u < image.width; ++u) {
+  const bool whole = roi[2] <= roi[0] || roi[3] <= roi[1];
+  const int u0 = whole ? 0 : std::max(0, roi[0]), v0 = whole ? 0 : std::max(0, roi[1]);
+  const int u1 = whole ? image.width : std::min(image.width, roi[2]);
+  const int v1 = whole ? image.height : std::min(image.height, roi[3]);
+  for (int v = v0; v < v1; ++v) {
+    for (int u = u0; u < u1; ++u) {
       const Eigen::Vector3f ray_cam = intrinsics.BackProject(u, v, 1.0).cast<float>();
       const Eigen::Vector3f ray = rotation * ray_cam.normalized();
       // Where the ray is inside the cube (slabs).

@@ -6,6 +6,7 @@
 // camera sees it (for ICP and previews); marching cubes gives its zero level set as a mesh.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -58,7 +59,9 @@ class TsdfVolume {
                 const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume);
 
   /// The model's surface seen from `cam_from_volume`: the first zero crossing along each ray.
-  RaycastImage Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume) const;
+  /// Only the pixels in `roi` (u0, v0, u1, v1, exclusive ends; all when empty) are cast.
+  RaycastImage Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume,
+                       const std::array<int, 4>& roi = {0, 0, 0, 0}) const;
 
   /// The zero level set by marching cubes (volume frame, mm), over cells whose eight corners
   /// have all been observed; with per-vertex colour when kept. Vertices are shared between

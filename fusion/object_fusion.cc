@@ -1,0 +1,133 @@
+#include "fusion/object_fusion.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/check.h"
+
+namespace ihs::fusion {
+
+const char* ToString(FusionStatus status) {
+  switch (status) {
+    case FusionStatus::kStarted:
+      return "started";
+    case FusionStatus::kFused:
+      return "fused";
+    case FusionStatus::kSkipped:
+      return "skipped";
+  }
+  return "unknown";
+}
+
+void FusionOptions::Check() const {
+  tsdf.Check();
+  pairwise.Check();
+  icp.Check();
+  IHS_CHECK_ARG(min_object_points >= 10, "fusion.min_object_points must be >= 10");
+  IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
+                "fusion.max_jump_mm and max_jump_deg must be positive");
+}
+
+ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
+    : intrinsics_(intrinsics),
+      options_((options.Check(), std::move(options))),
+      volume_(options_.tsdf) {}
+
+FusionResult ObjectFusion::Fuse(const FusionInput& input) {
+  const auto started_at = std::chrono::steady_clock::now();
+  IHS_CHECK_ARG(input.frame != nullptr && input.object_mask != nullptr,
+                "Fuse needs a frame and its object mask");
+  const Frame& frame = *input.frame;
+  const std::vector<std::uint8_t>& mask = *input.object_mask;
+  IHS_CHECK_ARG(mask.size() == frame.depth_mm.size(), "the object mask does not fit the frame");
+  FusionResult result;
+  result.cam_from_object = cam_from_object_;
+  auto finish = [&](FusionStatus status, std::string reason = {}) {
+    result.status = status;
+    result.reason = std::move(reason);
+    result.milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started_at)
+            .count();
+    return std::move(result);
+  };
+
+  // The object's points and where they are in the image.
+  std::vector<Eigen::Vector3f> points;
+  std::array<int, 4> box = {frame.width, frame.height, 0, 0};
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const int pixel = v * frame.width + u;
+      if (!mask[pixel] || frame.depth_mm[pixel] == 0) continue;
+      points.push_back(intrinsics_.BackProject(u, v, frame.depth_mm[pixel]).cast<float>());
+      box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u + 1),
+             std::max(box[3], v + 1)};
+    }
+  }
+  if (static_cast<int>(points.size()) < options_.min_object_points) {
+    return finish(FusionStatus::kSkipped,
+                  "too few object points: " + std::to_string(points.size()) + " (need " +
+                      std::to_string(options_.min_object_points) + ")");
+  }
+
+  if (!started_) {
+    // The volume around the object: centred on its points, axes the camera's.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const auto& p : points) centre += p.cast<double>();
+    centre /= static_cast<double>(points.size());
+    cam_from_object_ = Rigid3::Translation(centre);
+    result.cam_from_object = cam_from_object_;
+    result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, cam_from_object_);
+    started_ = true;
+    return finish(FusionStatus::kStarted);
+  }
+
+  // The correspondences' motion, then ICP from there.
+  Rigid3 pose = cam_from_object_;
+  result.pairwise = RegisterPair(input.correspondences, options_.pairwise);
+  if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
+  if (options_.use_icp) {
+    // The model where the object was, grown by the largest plausible jump.
+    const int margin = static_cast<int>(
+        std::ceil(options_.max_jump_mm * intrinsics_.fx / std::max(1.0, pose.translation().z())));
+    const std::array<int, 4> roi = {box[0] - margin, box[1] - margin, box[2] + margin,
+                                    box[3] + margin};
+    // The contacts, where the registration moved them, hold ICP where the surface cannot.
+    std::vector<IcpAnchor> anchors;
+    if (result.pairwise.ok && options_.pairwise.contact_weight > 0) {
+      for (const PointMatch& contact : input.correspondences.contacts) {
+        anchors.push_back({contact.current,
+                           result.pairwise.current_from_previous * contact.previous,
+                           options_.pairwise.contact_weight});
+      }
+    }
+    result.icp = AlignToModel(points, volume_.Raycast(intrinsics_, pose, roi), intrinsics_, pose,
+                              options_.icp, anchors);
+    if (result.icp.ok) {
+      pose = result.icp.cam_from_volume;
+    } else if (!result.pairwise.ok) {
+      return finish(FusionStatus::kSkipped,
+                    "no registration: " + result.pairwise.reason + "; " + result.icp.reason);
+    }
+  } else if (!result.pairwise.ok) {
+    return finish(FusionStatus::kSkipped, "no registration: " + result.pairwise.reason);
+  }
+
+  // A plausible step from the previous pose?
+  const Rigid3 step = pose * cam_from_object_.Inverse();
+  const double moved = (pose.translation() - cam_from_object_.translation()).norm();
+  const double turned = Eigen::AngleAxisd(step.rotation()).angle() * 180.0 / M_PI;
+  if (moved > options_.max_jump_mm || turned > options_.max_jump_deg) {
+    char reason[128];
+    std::snprintf(reason, sizeof reason, "implausible jump: %.1f mm, %.1f° from the last frame",
+                  moved, turned);
+    return finish(FusionStatus::kSkipped, reason);
+  }
+  cam_from_object_ = pose;
+  result.cam_from_object = pose;
+  result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
+  return finish(FusionStatus::kFused);
+}
+
+}  // namespace ihs::fusion

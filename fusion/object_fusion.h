@@ -1,0 +1,94 @@
+#pragma once
+// The fusion stage: per frame, the object's motion since the previous frame from its
+// correspondences (features and fingertip contacts, pairwise_registration.h), refined by ICP
+// against the model (icp.h), then the object's pixels integrated into the TSDF (tsdf_volume.h).
+// One obvious entry point: Fuse(input). The volume is placed around the object in the first
+// frame; its frame is the object frame of everything that follows.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+#include "fusion/icp.h"
+#include "fusion/pairwise_registration.h"
+#include "fusion/tsdf_volume.h"
+
+namespace ihs::fusion {
+
+/// Options of the fusion stage (defaults: the paper's).
+struct FusionOptions {
+  TsdfOptions tsdf;
+  PairwiseOptions pairwise;
+  IcpOptions icp;
+  /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
+  bool use_icp = true;
+  /// A frame needs this many object points.
+  int min_object_points = 200;
+  /// A pose that moves the object's centre farther than this, or turns it by more than this,
+  /// from the previous frame is implausible: the frame is skipped, not integrated.
+  double max_jump_mm = 40.0;
+  double max_jump_deg = 30.0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// One frame for the fusion stage.
+struct FusionInput {
+  /// Depth (mm) with registered colour.
+  const Frame* frame = nullptr;
+  /// Per pixel: non-zero where the object is (the tracker's object mask).
+  const std::vector<std::uint8_t>* object_mask = nullptr;
+  /// Correspondences with the previous frame (camera frame, mm).
+  PairwiseInput correspondences;
+};
+
+/// What happened to a frame.
+enum class FusionStatus {
+  kStarted,  ///< The first frame: the volume is placed around the object and fused.
+  kFused,    ///< Registered and integrated.
+  kSkipped,  ///< Not integrated; `reason` says why.
+};
+
+/// A short name for stats and logs ("started", "fused", "skipped").
+const char* ToString(FusionStatus status);
+
+/// The stage's result for one frame.
+struct FusionResult {
+  FusionStatus status = FusionStatus::kSkipped;
+  std::string reason;
+  /// The object's pose in this frame (the previous one when skipped).
+  Rigid3 cam_from_object;
+  /// How the pose was found.
+  PairwiseResult pairwise;
+  IcpResult icp;
+  int integrated_voxels = 0;
+  double milliseconds = 0;
+};
+
+/// Registers and fuses an object frame by frame. Not thread-safe; the fusion thread owns it.
+class ObjectFusion {
+ public:
+  ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options = {});
+
+  FusionResult Fuse(const FusionInput& input);
+
+  /// The raw marching-cubes mesh of the model so far (object frame, mm).
+  TriangleMesh ExtractMesh() const { return volume_.ExtractMesh(); }
+  const TsdfVolume& volume() const { return volume_; }
+  bool started() const { return started_; }
+  const FusionOptions& options() const { return options_; }
+
+ private:
+  const CameraIntrinsics intrinsics_;
+  const FusionOptions options_;
+  TsdfVolume volume_;
+  bool started_ = false;
+  Rigid3 cam_from_object_;
+};
+
+}  // namespace ihs::fusion

@@ -1,0 +1,160 @@
+// The fusion stage on an analytic sequence: an ellipsoid (and a sphere) turned a full turn in
+// front of the camera, with fingertip contacts on it; the trajectory and the mesh against the
+// truth, each registration source alone, and frames that must be skipped.
+
+#include "fusion/object_fusion.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include "tests/frame_fixtures.h"
+#include "tests/test_util.h"
+
+namespace ihs::fusion {
+namespace {
+
+const CameraIntrinsics kIntrinsics = CameraIntrinsics::Carmine109();
+constexpr int kFrames = 90;  // 4° a frame: a full turn.
+
+// The object's true pose in frame i: turning about a tilted axis through its centre.
+Rigid3 Truth(int i) {
+  return Rigid3::Translation({5, -10, 600}) *
+         Rigid3::FromAxisAngle(Eigen::Vector3d(0.3, 1, 0.2), i * 4 * M_PI / 180) *
+         Rigid3::FromAxisAngle({1, 0, 0}, 0.3);
+}
+
+struct SequenceRun {
+  std::vector<FusionResult> results;
+  double pose_error_mm = 0;  // The worst over the sequence, at the object's extreme points.
+  TriangleMesh mesh;         // In the object's own frame.
+};
+
+// Fuses the sequence; `contacts` fixed points of the object touch the fingers (noise 0.3 mm).
+SequenceRun FuseSequence(const Eigen::Vector3d& semi_axes, int contacts,
+                         const FusionOptions& options) {
+  std::mt19937 rng = test::Rng();
+  std::normal_distribution<double> noise(0, 0.3);
+  std::vector<Eigen::Vector3d> touched;  // Object frame.
+  for (int k = 0; k < contacts; ++k) {
+    const double angle = 2 * M_PI * k / std::max(1, contacts);
+    touched.push_back(semi_axes.cwiseProduct(Eigen::Vector3d(std::cos(angle), std::sin(angle), 0)));
+  }
+  ObjectFusion fusion(kIntrinsics, options);
+  SequenceRun run;
+  for (int i = 0; i < kFrames; ++i) {
+    const Frame frame = test::RenderEllipsoid(kIntrinsics, Truth(i), semi_axes);
+    std::vector<std::uint8_t> mask(frame.depth_mm.size());
+    for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+    FusionInput input{&frame, &mask, {}};
+    if (i > 0) {
+      for (const Eigen::Vector3d& q : touched) {
+        input.correspondences.contacts.push_back(
+            {Truth(i - 1) * q, Truth(i) * q + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))});
+      }
+    }
+    run.results.push_back(fusion.Fuse(input));
+  }
+  // The volume's frame is fixed to the object: cam_from_volume(i) = Truth(i)·object_from_volume.
+  // The error: the largest over the sequence, at the object's extreme points.
+  const Rigid3 object_from_volume = Truth(0).Inverse() * run.results.front().cam_from_object;
+  for (int i = 0; i < kFrames; ++i) {
+    const Rigid3 expected = Truth(i) * object_from_volume;
+    for (int axis = 0; axis < 3; ++axis) {
+      for (double sign : {-1.0, 1.0}) {
+        Eigen::Vector3d p = Eigen::Vector3d::Zero();
+        p[axis] = sign * semi_axes[axis];
+        const Eigen::Vector3d in_volume = object_from_volume.Inverse() * p;
+        run.pose_error_mm =
+            std::max(run.pose_error_mm,
+                     (run.results[i].cam_from_object * in_volume - expected * in_volume).norm());
+      }
+    }
+  }
+  run.mesh = fusion.ExtractMesh();
+  for (auto& v : run.mesh.vertices)
+    v = (object_from_volume * Eigen::Vector3d(v.cast<double>())).cast<float>();
+  return run;
+}
+
+// Mean distance of mesh vertices from the ellipsoid, approximately (radial, mm).
+double MeshError(const TriangleMesh& mesh, const Eigen::Vector3d& semi_axes) {
+  double sum = 0;
+  for (const auto& v : mesh.vertices) {
+    const Eigen::Vector3d p = v.cast<double>();
+    const double scale = p.cwiseQuotient(semi_axes).norm();  // 1 on the surface.
+    sum += std::abs(p.norm() * (1 - 1 / scale));
+  }
+  return sum / std::max<size_t>(1, mesh.vertices.size());
+}
+
+int Count(const SequenceRun& run, FusionStatus status) {
+  return static_cast<int>(std::count_if(run.results.begin(), run.results.end(),
+                                        [&](const FusionResult& r) { return r.status == status; }));
+}
+
+TEST(ObjectFusionTest, AFullTurnOfAnEllipsoidWithContactsAndIcpStaysOnTrack) {
+  const Eigen::Vector3d axes(45, 30, 18);
+  const SequenceRun run = FuseSequence(axes, 6, {});
+  std::printf("ellipsoid, contacts + ICP: %d fused, worst pose error %.2f mm, mesh error %.3f mm\n",
+              Count(run, FusionStatus::kFused), run.pose_error_mm, MeshError(run.mesh, axes));
+  EXPECT_EQ(run.results.front().status, FusionStatus::kStarted);
+  EXPECT_EQ(Count(run, FusionStatus::kFused), kFrames - 1);
+  // Measured: worst pose error 1.59 mm over the turn, mesh 0.28 mm from the surface.
+  EXPECT_LT(run.pose_error_mm, 3.0);
+  EXPECT_LT(MeshError(run.mesh, axes), 0.5);
+}
+
+TEST(ObjectFusionTest, OnASphereOnlyTheContactsKeepTheTurn) {
+  // A sphere looks the same however it turns: ICP alone cannot see the rotation, the fingertips
+  // can (the paper's case).
+  const Eigen::Vector3d sphere = Eigen::Vector3d::Constant(35);
+  const SequenceRun icp_only = FuseSequence(sphere, 0, {});
+  const SequenceRun with_contacts = FuseSequence(sphere, 6, {});
+  FusionOptions no_icp;
+  no_icp.use_icp = false;
+  const SequenceRun contacts_only = FuseSequence(sphere, 6, no_icp);
+  std::printf(
+      "sphere: worst pose error ICP only %.1f mm, contacts + ICP %.2f mm, contacts only "
+      "%.2f mm\n",
+      icp_only.pose_error_mm, with_contacts.pose_error_mm, contacts_only.pose_error_mm);
+  // Measured: 69.8 mm with ICP alone, 5.0 mm with the contacts (0.3 mm of noise each, adding
+  // up over the turn), 4.6 mm with the contacts alone.
+  EXPECT_GT(icp_only.pose_error_mm, 20.0);
+  EXPECT_LT(with_contacts.pose_error_mm, 7.0);
+  EXPECT_LT(contacts_only.pose_error_mm, 7.0);
+  EXPECT_EQ(Count(contacts_only, FusionStatus::kFused), kFrames - 1);
+}
+
+TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
+  const Eigen::Vector3d axes(45, 30, 18);
+  ObjectFusion fusion(kIntrinsics);
+  const Frame empty = Frame::Blank(640, 480, true);
+  const std::vector<std::uint8_t> no_mask(empty.depth_mm.size(), 0);
+  FusionResult result = fusion.Fuse({&empty, &no_mask, {}});
+  EXPECT_EQ(result.status, FusionStatus::kSkipped);
+  EXPECT_NE(result.reason.find("too few object points"), std::string::npos) << result.reason;
+  EXPECT_FALSE(fusion.started());
+
+  const Frame first = test::RenderEllipsoid(kIntrinsics, Truth(0), axes);
+  std::vector<std::uint8_t> mask(first.depth_mm.size());
+  for (size_t p = 0; p < mask.size(); ++p) mask[p] = first.depth_mm[p] != 0;
+  EXPECT_EQ(fusion.Fuse({&first, &mask, {}}).status, FusionStatus::kStarted);
+  // Contacts that claim the object jumped 80 mm: not integrated.
+  FusionInput jump{&first, &mask, {}};
+  for (int k = 0; k < 5; ++k) {
+    const Eigen::Vector3d p = Truth(0) * Eigen::Vector3d(10.0 * k, 5.0 * k * k, 1.0 * k);
+    jump.correspondences.contacts.push_back({p, p + Eigen::Vector3d(80, 0, 0)});
+  }
+  FusionOptions no_icp;
+  no_icp.use_icp = false;
+  ObjectFusion contacts_only(kIntrinsics, no_icp);
+  contacts_only.Fuse({&first, &mask, {}});
+  result = contacts_only.Fuse(jump);
+  EXPECT_EQ(result.status, FusionStatus::kSkipped);
+  EXPECT_NE(result.reason.find("implausible jump"), std::string::npos) << result.reason;
+}
+
+}  // namespace
+}  // namespace ihs::fusion
