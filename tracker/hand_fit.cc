@@ -368,11 +368,11 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   std::vector<std::uint8_t> silhouette;
   std::vector<int> nearest_silhouette;
   std::array<int, 4> roi = {0, 0, 0, 0};
-  if (use_silhouette) {
+  // Once the samples are posed at the initial pose: the region around the model's image.
+  auto prepare_silhouette = [&]() {
     silhouette.resize(segmentation->hand_mask.size());
     for (size_t p = 0; p < silhouette.size(); ++p)
       silhouette[p] = segmentation->hand_mask[p] | segmentation->object_mask[p];
-    pose_samples(pose);
     constexpr int kMarginPx = 40;
     roi = {segmentation->width, segmentation->height, 0, 0};
     for (const Eigen::Vector3f& p : posed) {
@@ -387,7 +387,7 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
            std::min(segmentation->height, roi[3])};
     if (roi[2] > roi[0] && roi[3] > roi[1])
       nearest_silhouette = NearestSetPixels(silhouette, segmentation->width, roi);
-  }
+  };
   // Silhouette pairs: model points (seen or not) in the crop volume whose image lies outside
   // the silhouette, pulled to within the tolerance of its nearest pixel. The wrist's points are
   // left out: where a scan of the forearm ends (sleeve, crop) says nothing about the hand.
@@ -426,6 +426,7 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   std::vector<int> visible_samples;
   for (int outer = 0; outer < options_.outer_iterations; ++outer) {
     pose_samples(pose);
+    if (outer == 0 && use_silhouette) prepare_silhouette();
     visible_samples = find_visible();
     const auto& cam_from_bone = kinematics.cam_from_bone();
 
