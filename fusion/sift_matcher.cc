@@ -1,0 +1,77 @@
+#include "fusion/sift_matcher.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/check.h"
+
+namespace ihs::fusion {
+
+void SiftOptions::Check() const {
+  IHS_CHECK_ARG(max_features >= 10, "sift.max_features must be >= 10");
+  IHS_CHECK_ARG(ratio > 0 && ratio < 1, "sift.ratio must be in (0, 1)");
+}
+
+struct SiftMatcher::State {
+  cv::Ptr<cv::SIFT> sift;
+  cv::BFMatcher matcher{cv::NORM_L2};
+  bool has_previous = false;
+  std::vector<Eigen::Vector3d> previous_points;
+  cv::Mat previous_descriptors;
+};
+
+SiftMatcher::SiftMatcher(const CameraIntrinsics& intrinsics, SiftOptions options)
+    : intrinsics_(intrinsics),
+      options_((options.Check(), options)),
+      state_(std::make_unique<State>()) {
+  state_->sift = cv::SIFT::create(options_.max_features);
+}
+
+SiftMatcher::~SiftMatcher() = default;
+
+std::vector<PointMatch> SiftMatcher::Match(const Frame& frame,
+                                           const std::vector<std::uint8_t>& object_mask) {
+  IHS_CHECK_ARG(object_mask.size() == frame.depth_mm.size(),
+                "the object mask does not fit the frame");
+  std::vector<PointMatch> matches;
+  if (!frame.HasColor()) {
+    state_->has_previous = false;
+    return matches;
+  }
+  cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+  cv::Mat gray;
+  cv::cvtColor(rgb, gray, cv::COLOR_RGB2GRAY);
+  cv::Mat mask(frame.height, frame.width, CV_8U);
+  for (int pixel = 0; pixel < frame.PixelCount(); ++pixel) {
+    mask.data[pixel] = object_mask[pixel] && frame.depth_mm[pixel] != 0 ? 255 : 0;
+  }
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  state_->sift->detectAndCompute(gray, mask, keypoints, descriptors);
+  // Keypoints with depth at their (rounded) position, back-projected.
+  std::vector<Eigen::Vector3d> points;
+  cv::Mat kept;
+  for (size_t k = 0; k < keypoints.size(); ++k) {
+    const int u = cvRound(keypoints[k].pt.x), v = cvRound(keypoints[k].pt.y);
+    if (u < 0 || v < 0 || u >= frame.width || v >= frame.height) continue;
+    const std::uint16_t z = frame.DepthAt(u, v);
+    if (z == 0 || !object_mask[v * frame.width + u]) continue;
+    points.push_back(intrinsics_.BackProject(keypoints[k].pt.x, keypoints[k].pt.y, z));
+    kept.push_back(descriptors.row(static_cast<int>(k)));
+  }
+  if (state_->has_previous && !kept.empty() && state_->previous_descriptors.rows >= 2) {
+    std::vector<std::vector<cv::DMatch>> candidates;
+    state_->matcher.knnMatch(kept, state_->previous_descriptors, candidates, 2);
+    for (const auto& pair : candidates) {
+      if (pair.size() < 2 || pair[0].distance >= options_.ratio * pair[1].distance) continue;
+      matches.push_back({state_->previous_points[pair[0].trainIdx], points[pair[0].queryIdx]});
+    }
+  }
+  state_->previous_points = std::move(points);
+  state_->previous_descriptors = kept;
+  state_->has_previous = true;
+  return matches;
+}
+
+}  // namespace ihs::fusion

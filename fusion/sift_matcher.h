@@ -1,0 +1,46 @@
+#pragma once
+// Visual correspondences between consecutive frames (paper §3.3, E_feat2d): SIFT keypoints on the
+// object's pixels of the colour image, matched to the previous frame's by Lowe's ratio test, each
+// match back-projected to 3D with its depth. Hand pixels never count: only the object mask is
+// searched.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "fusion/pairwise_registration.h"
+
+namespace ihs::fusion {
+
+/// Options of the SIFT matcher.
+struct SiftOptions {
+  /// Keypoints kept per frame, strongest first.
+  int max_features = 500;
+  /// Lowe's ratio: a match counts when its distance is below this share of the second best's.
+  double ratio = 0.8;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Matches each frame's object keypoints with the previous frame's. Not thread-safe.
+class SiftMatcher {
+ public:
+  explicit SiftMatcher(const CameraIntrinsics& intrinsics, SiftOptions options = {});
+  ~SiftMatcher();
+
+  /// The keypoints of `frame` inside `object_mask` (non-zero pixels, with depth), matched with
+  /// those of the previous call: (previous, current) 3D points, camera frame, mm. The first
+  /// call, and a frame without colour, give none.
+  std::vector<PointMatch> Match(const Frame& frame, const std::vector<std::uint8_t>& object_mask);
+
+ private:
+  struct State;
+  const CameraIntrinsics intrinsics_;
+  const SiftOptions options_;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace ihs::fusion
