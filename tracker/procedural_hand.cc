@@ -119,7 +119,6 @@ void AppendCapsule(HandModel& model, const Rigid3& model_from_capsule, double le
 }  // namespace
 
 void ProceduralHandOptions::Check() const {
-  IHS_CHECK_ARG(scale > 0.2 && scale < 5, "hand.scale must be in (0.2, 5), got " << scale);
   IHS_CHECK_ARG(wrist_length_mm > 0, "hand.wrist_length_mm must be positive");
   for (const auto& finger : finger_lengths_mm) {
     for (double length : finger)
@@ -144,7 +143,6 @@ void ProceduralHandOptions::Check() const {
 
 HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   options.Check();
-  const double s = options.scale;
   HandModel model;
   auto add_bone = [&](const std::string& name, int parent, double length, const Rigid3& frame,
                       JointLimits limits) {
@@ -158,7 +156,7 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   root.translation = true;
   root.active = {true, true, true};
   root.limits_deg = {{{-180, 180}, {-180, 180}, {-180, 180}}};
-  const double wrist = options.wrist_length_mm * s;
+  const double wrist = options.wrist_length_mm;
   add_bone("Lower Arm R", -1, wrist, BoneFrame({0, 0, -wrist}, Eigen::Vector3d::UnitZ()), root);
 
   // Fingers 0..3 (pinky to index): metacarpals fan out from the wrist to the knuckles.
@@ -166,8 +164,8 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   for (int f = 0; f < 4; ++f) {
     const auto& lengths = options.finger_lengths_mm[f];
     const std::string prefix = "RFing." + std::to_string(f) + "_";
-    const Eigen::Vector3d start(base_x[f] * s, 0, 0);
-    const Eigen::Vector3d knuckle(knuckle_x[f] * s, 0, lengths[0] * s);
+    const Eigen::Vector3d start(base_x[f], 0, 0);
+    const Eigen::Vector3d knuckle(knuckle_x[f], 0, lengths[0]);
     const Eigen::Vector3d direction = (knuckle - start).normalized();
     Rigid3 frame = BoneFrame(start, direction);
     int parent = 0;
@@ -176,14 +174,14 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
         Limits({{{0, 0}, {-100, 10}, {0, 0}}}), Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
     const char* names[4] = {"Hand", "0", "1", "2"};
     for (int k = 0; k < 4; ++k) {
-      const double length = (k == 0 ? (knuckle - start).norm() : lengths[k] * s);
+      const double length = (k == 0 ? (knuckle - start).norm() : lengths[k]);
       parent = add_bone(prefix + names[k], parent, length, frame, joint_limits[k]);
       frame = frame * Rigid3::Translation({length, 0, 0});  // The child starts at the end.
     }
   }
   // Thumb: from the side of the wrist, toward +x and forward, turned toward the palm.
   {
-    const Eigen::Vector3d start(18 * s, 4 * s, 5 * s);
+    const Eigen::Vector3d start(18, 4, 5);
     Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, 0.25, 0.6));
     const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-30, 40}}}),
                                          Limits({{{0, 0}, {-60, 10}, {-15, 15}}}),
@@ -191,7 +189,7 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     const char* names[3] = {"Hand", "0", "1"};
     int parent = 0;
     for (int k = 0; k < 3; ++k) {
-      const double length = options.thumb_lengths_mm[k] * s;
+      const double length = options.thumb_lengths_mm[k];
       parent = add_bone(std::string("RFing.4_") + names[k], parent, length, frame, joint_limits[k]);
       frame = frame * Rigid3::Translation({length, 0, 0});
     }
@@ -200,18 +198,18 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   // Skin. The palm: one flat capsule from the wrist to the knuckles, each point skinned to
   // the metacarpals nearest across the palm (and to the wrist near its start).
   const int segments = options.segments;
-  const double palm_length = 58 * s, palm_radius = options.palm_base_width_mm / 2 * s;
+  const double palm_length = 58, palm_radius = options.palm_base_width_mm / 2;
   std::array<int, 4> metacarpals;
   for (int f = 0; f < 4; ++f)
     metacarpals[f] = model.BoneIndex("RFing." + std::to_string(f) + "_Hand");
   const WeightFunction palm_weights = [&](const Eigen::Vector3d& p) {
     VertexWeights weights;
-    const double along = std::clamp(p.z() / (palm_length + 8 * s), 0.0, 1.0);
-    const double to_wrist = 0.5 * std::max(0.0, 1 - p.z() / (20 * s));
+    const double along = std::clamp(p.z() / (palm_length + 8), 0.0, 1.0);
+    const double to_wrist = 0.5 * std::max(0.0, 1 - p.z() / 20);
     double raw[4], sum = 0;
     for (int f = 0; f < 4; ++f) {
-      const double axis_x = (base_x[f] + (knuckle_x[f] - base_x[f]) * along) * s;
-      raw[f] = std::exp(-std::pow((p.x() - axis_x) / (12 * s), 2)) + 1e-6;
+      const double axis_x = base_x[f] + (knuckle_x[f] - base_x[f]) * along;
+      raw[f] = std::exp(-std::pow((p.x() - axis_x) / 12, 2)) + 1e-6;
       sum += raw[f];
     }
     for (int f = 0; f < 4; ++f) {
@@ -220,13 +218,12 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     if (to_wrist > 0) weights.bones.emplace_back(0, static_cast<float>(to_wrist));
     return weights;
   };
-  AppendCapsule(model, BoneFrame({0, 0, 8 * s}, Eigen::Vector3d::UnitZ()), palm_length, palm_radius,
-                12 * s,
+  AppendCapsule(model, BoneFrame({0, 0, 8}, Eigen::Vector3d::UnitZ()), palm_length, palm_radius, 12,
                 {options.palm_thickness_mm / options.palm_base_width_mm, 3.0,
                  options.palm_width_mm / options.palm_base_width_mm},
                 segments * 2, palm_weights);
   // The wrist: a shorter, flat capsule on the root bone.
-  AppendCapsule(model, model.model_from_bone_rest[0], wrist, options.wrist_width_mm / 2 * s, 10 * s,
+  AppendCapsule(model, model.model_from_bone_rest[0], wrist, options.wrist_width_mm / 2, 10,
                 {options.wrist_thickness_mm / options.wrist_width_mm, 2.0}, segments * 2,
                 JointBlendWeights(model, 0));
   // Fingers and thumb: round capsules on the phalanges and the thumb's metacarpal.
@@ -242,9 +239,9 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     const bool proximal = model.bones[model.bones[bone].parent].name.ends_with("Hand");
     const double taper =
         distal ? options.distal_taper : (proximal ? 1.0 : 0.5 * (1.0 + options.distal_taper));
-    const double radius = options.finger_radius_mm[finger] * s * (metacarpal ? 1.3 : taper);
+    const double radius = options.finger_radius_mm[finger] * (metacarpal ? 1.3 : taper);
     double length = model.bones[bone].length_mm;
-    if (distal) length = std::max(0.3 * length, length - radius + kTipBeyondEndMm * s);
+    if (distal) length = std::max(0.3 * length, length - radius + kTipBeyondEndMm);
     AppendCapsule(model, model.model_from_bone_rest[bone], length, radius, radius,
                   {metacarpal ? 0.7 : 0.9, 2.0}, segments, JointBlendWeights(model, bone));
   }

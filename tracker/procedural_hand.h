@@ -13,8 +13,6 @@ namespace ihs::tracker {
 /// Dimensions of the procedural hand (mm). Defaults: an adult right hand (bone lengths of the
 /// paper's scanned hand).
 struct ProceduralHandOptions {
-  /// Uniform scale applied to every length and radius.
-  double scale = 1.0;
   /// Wrist (root) bone length.
   double wrist_length_mm = 17.6;
   /// Fingers pinky, ring, middle, index: metacarpal, proximal, middle, distal phalanx.
@@ -45,8 +43,9 @@ struct ProceduralHandOptions {
   void Check() const;
 };
 
-/// Builds the procedural hand. Rest pose: flat hand, fingers toward +z, thumb toward +x, palm
-/// facing +y (negative flexion bends toward the palm), wrist at the origin.
+/// Builds the procedural hand (HandModel::Scaled gives it another size). Rest pose: flat hand,
+/// fingers toward +z, thumb toward +x, palm facing +y (negative flexion bends toward the palm),
+/// wrist at the origin.
 HandModel MakeProceduralHand(const ProceduralHandOptions& options = {});
 
 }  // namespace ihs::tracker
