@@ -75,4 +75,18 @@ Frame RenderEllipsoid(const CameraIntrinsics& intrinsics, const Rigid3& cam_from
   return frame;
 }
 
+std::vector<Rigid3> ViewsAround(double distance_mm) {
+  const Rigid3 away = Rigid3::Translation({0, 0, distance_mm});
+  std::vector<Rigid3> views;
+  for (int a = 0; a < 8; ++a) {
+    for (double tilt : {-0.9, 0.0, 0.9}) {
+      views.push_back(away * Rigid3::FromAxisAngle({1, 0, 0}, tilt) *
+                      Rigid3::FromAxisAngle({0, 1, 0}, a * M_PI / 4));
+    }
+  }
+  views.push_back(away * Rigid3::FromAxisAngle({1, 0, 0}, M_PI / 2));
+  views.push_back(away * Rigid3::FromAxisAngle({1, 0, 0}, -M_PI / 2));
+  return views;
+}
+
 }  // namespace ihs::test

@@ -28,4 +28,8 @@ Frame RenderEllipsoid(const CameraIntrinsics& intrinsics, const Rigid3& cam_from
 double EllipsoidDepth(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object,
                       const Eigen::Vector3d& semi_axes_mm, double u, double v);
 
+/// Camera poses all around an object at the origin, `distance_mm` in front of the camera: eight
+/// turns about the y axis at three tilts about x, plus straight from above and below (26 views).
+std::vector<Rigid3> ViewsAround(double distance_mm);
+
 }  // namespace ihs::test

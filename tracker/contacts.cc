@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/check.h"
-#include "tracker/point_kd_tree.h"
+#include "core/point_kd_tree.h"
 
 namespace ihs::tracker {
 

@@ -9,9 +9,11 @@
 
 #include "tracker/hand_model.h"
 
-namespace ihs::tracker {
-
+namespace ihs {
 class PointKdTree;
+}  // namespace ihs
+
+namespace ihs::tracker {
 
 /// Options of the contact detection (defaults: the paper's, with the growth bounded at 6 mm:
 /// where a fingertip pinches an object from the side, the camera sees little of the object's

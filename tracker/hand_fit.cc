@@ -8,7 +8,7 @@
 #include "core/check.h"
 #include "core/rigid_fit.h"
 #include "tracker/hand_fit_cost.h"
-#include "tracker/point_kd_tree.h"
+#include "core/point_kd_tree.h"
 
 namespace ihs::tracker {
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "core/check.h"
-#include "tracker/point_kd_tree.h"
+#include "core/point_kd_tree.h"
 
 namespace ihs::tracker {
 namespace {

@@ -21,26 +21,11 @@ Frame RenderSphere(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_vo
   return test::RenderEllipsoid(intrinsics, cam_from_volume, Eigen::Vector3d::Constant(kRadius));
 }
 
-// Views from all around: the sphere 600 mm in front of the camera, turned about two axes.
-std::vector<Rigid3> ViewsAround() {
-  std::vector<Rigid3> views;
-  for (int a = 0; a < 8; ++a) {
-    for (double tilt : {-0.9, 0.0, 0.9}) {
-      const Rigid3 turn =
-          Rigid3::FromAxisAngle({1, 0, 0}, tilt) * Rigid3::FromAxisAngle({0, 1, 0}, a * M_PI / 4);
-      views.push_back(Rigid3::Translation({0, 0, 600}) * turn);
-    }
-  }
-  views.push_back(Rigid3::Translation({0, 0, 600}) * Rigid3::FromAxisAngle({1, 0, 0}, M_PI / 2));
-  views.push_back(Rigid3::Translation({0, 0, 600}) * Rigid3::FromAxisAngle({1, 0, 0}, -M_PI / 2));
-  return views;
-}
-
 TEST(TsdfVolumeTest, ASphereSeenFromAllAroundMeshesClosedAtItsRadiusWithItsColours) {
   const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
   TsdfVolume volume;
   EXPECT_NEAR(volume.voxel_mm(), 350.0 / 256, 1e-12);
-  for (const Rigid3& view : ViewsAround()) {
+  for (const Rigid3& view : test::ViewsAround(600)) {
     const Frame frame = RenderSphere(intrinsics, view);
     EXPECT_GT(volume.Integrate(frame, {}, intrinsics, view), 1000);
   }
@@ -84,7 +69,7 @@ TEST(TsdfVolumeTest, ASphereSeenFromAllAroundMeshesClosedAtItsRadiusWithItsColou
 TEST(TsdfVolumeTest, RaycastSeesTheSphereFromANewView) {
   const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
   TsdfVolume volume;
-  for (const Rigid3& view : ViewsAround()) {
+  for (const Rigid3& view : test::ViewsAround(600)) {
     volume.Integrate(RenderSphere(intrinsics, view), {}, intrinsics, view);
   }
   const Rigid3 view =

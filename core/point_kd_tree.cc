@@ -1,8 +1,8 @@
-#include "tracker/point_kd_tree.h"
+#include "core/point_kd_tree.h"
 
 #include <nanoflann.hpp>
 
-namespace ihs::tracker {
+namespace ihs {
 namespace {
 
 struct Cloud {
@@ -54,4 +54,4 @@ int PointKdTree::CountWithin(const Eigen::Vector3f& query, float radius_mm) cons
       index_->tree.radiusSearch(query.data(), radius_mm * radius_mm, matches, params));
 }
 
-}  // namespace ihs::tracker
+}  // namespace ihs

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-namespace ihs::tracker {
+namespace ihs {
 
 /// A k-d tree over points (copied in).
 class PointKdTree {
@@ -28,4 +28,4 @@ class PointKdTree {
   std::unique_ptr<Index> index_;
 };
 
-}  // namespace ihs::tracker
+}  // namespace ihs

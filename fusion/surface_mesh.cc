@@ -1,0 +1,215 @@
+#include "fusion/surface_mesh.h"
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/surface/poisson.h>
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+#include <vector>
+
+#include "core/check.h"
+#include "core/point_kd_tree.h"
+
+namespace ihs::fusion {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+int Root(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+// The mesh with only the faces whose flag is set, and only the vertices they use.
+TriangleMesh KeepFaces(const TriangleMesh& mesh, const std::vector<bool>& keep) {
+  TriangleMesh out;
+  std::vector<std::int32_t> new_index(mesh.vertices.size(), -1);
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (!keep[f]) continue;
+    TriangleMesh::Face face;
+    for (int c = 0; c < 3; ++c) {
+      const std::int32_t v = mesh.faces[f][c];
+      if (new_index[v] < 0) {
+        new_index[v] = static_cast<std::int32_t>(out.vertices.size());
+        out.vertices.push_back(mesh.vertices[v]);
+        if (mesh.HasNormals()) out.normals.push_back(mesh.normals[v]);
+        if (mesh.HasColors()) out.colors.push_back(mesh.colors[v]);
+      }
+      face[c] = new_index[v];
+    }
+    out.faces.push_back(face);
+  }
+  return out;
+}
+
+}  // namespace
+
+void MeshingOptions::Check() const {
+  IHS_CHECK_ARG(min_component_fraction >= 0 && min_component_fraction <= 1,
+                "meshing.min_component_fraction must be in [0, 1], got " << min_component_fraction);
+  IHS_CHECK_ARG(smoothing_iterations >= 0 && smoothing_iterations <= 100,
+                "meshing.smoothing_iterations must be in [0, 100], got " << smoothing_iterations);
+  IHS_CHECK_ARG(smoothing_alpha >= 0 && smoothing_alpha <= 1,
+                "meshing.smoothing_alpha must be in [0, 1], got " << smoothing_alpha);
+  IHS_CHECK_ARG(smoothing_beta >= 0 && smoothing_beta <= 1,
+                "meshing.smoothing_beta must be in [0, 1], got " << smoothing_beta);
+  IHS_CHECK_ARG(poisson_depth >= 5 && poisson_depth <= 12,
+                "meshing.poisson_depth must be in [5, 12], got " << poisson_depth);
+  IHS_CHECK_ARG(
+      poisson_samples_per_node >= 1 && poisson_samples_per_node <= 50,
+      "meshing.poisson_samples_per_node must be in [1, 50], got " << poisson_samples_per_node);
+}
+
+TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction) {
+  std::vector<int> parent(mesh.vertices.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& face : mesh.faces) {
+    const int a = Root(parent, face[0]);
+    parent[Root(parent, face[1])] = a;
+    parent[Root(parent, face[2])] = a;
+  }
+  std::vector<int> faces_of(mesh.vertices.size(), 0);
+  for (const auto& face : mesh.faces) ++faces_of[Root(parent, face[0])];
+  const int largest = faces_of.empty() ? 0 : *std::max_element(faces_of.begin(), faces_of.end());
+  std::vector<bool> keep(mesh.faces.size());
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    keep[f] = faces_of[Root(parent, mesh.faces[f][0])] >= min_fraction * largest;
+  }
+  return KeepFaces(mesh, keep);
+}
+
+void SmoothHcLaplacian(TriangleMesh* mesh, int iterations, double alpha, double beta) {
+  const size_t n = mesh->vertices.size();
+  if (iterations <= 0 || n == 0) return;
+  // Vertex neighbourhoods through the faces' edges.
+  std::vector<std::vector<std::int32_t>> neighbours(n);
+  for (const auto& face : mesh->faces) {
+    for (int c = 0; c < 3; ++c) {
+      neighbours[face[c]].push_back(face[(c + 1) % 3]);
+      neighbours[face[c]].push_back(face[(c + 2) % 3]);
+    }
+  }
+  for (auto& list : neighbours) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  const std::vector<Eigen::Vector3f> original = mesh->vertices;
+  std::vector<Eigen::Vector3f>& p = mesh->vertices;
+  std::vector<Eigen::Vector3f> q(n), b(n);
+  const float a = static_cast<float>(alpha), be = static_cast<float>(beta);
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    q = p;
+    // Laplacian step, and how far it moved each vertex from a blend of its original and
+    // previous positions.
+    for (size_t i = 0; i < n; ++i) {
+      if (neighbours[i].empty()) {
+        b[i].setZero();
+        continue;
+      }
+      Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+      for (std::int32_t j : neighbours[i]) mean += q[j];
+      p[i] = mean / static_cast<float>(neighbours[i].size());
+      b[i] = p[i] - (a * original[i] + (1 - a) * q[i]);
+    }
+    // Push back by the vertex's own move and its neighbours' mean move.
+    for (size_t i = 0; i < n; ++i) {
+      if (neighbours[i].empty()) continue;
+      Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+      for (std::int32_t j : neighbours[i]) mean += b[j];
+      mean /= static_cast<float>(neighbours[i].size());
+      p[i] -= be * b[i] + (1 - be) * mean;
+    }
+  }
+  mesh->ComputeVertexNormals();
+}
+
+TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
+                                bool color) {
+  constexpr size_t kMinPoints = 16;
+  if (mesh.vertices.size() < kMinPoints) return {};
+  TriangleMesh oriented = mesh;
+  if (!oriented.HasNormals()) oriented.ComputeVertexNormals();
+
+  pcl::PointCloud<pcl::PointNormal>::Ptr cloud(new pcl::PointCloud<pcl::PointNormal>);
+  cloud->reserve(oriented.vertices.size());
+  for (size_t i = 0; i < oriented.vertices.size(); ++i) {
+    const Eigen::Vector3f& n = oriented.normals[i];
+    if (!n.allFinite() || n.squaredNorm() < 0.25f) continue;  // Vertices of degenerate faces.
+    pcl::PointNormal point;
+    point.getVector3fMap() = oriented.vertices[i];
+    point.getNormalVector3fMap() = n;
+    cloud->push_back(point);
+  }
+  if (cloud->size() < kMinPoints) return {};
+
+  pcl::Poisson<pcl::PointNormal> poisson;
+  poisson.setDepth(depth);
+  poisson.setSamplesPerNode(static_cast<float>(samples_per_node));
+  poisson.setManifold(true);
+  poisson.setOutputPolygons(false);
+  poisson.setInputCloud(cloud);
+  pcl::PointCloud<pcl::PointNormal> points;
+  std::vector<pcl::Vertices> polygons;
+  poisson.reconstruct(points, polygons);
+
+  TriangleMesh out;
+  out.vertices.reserve(points.size());
+  for (const auto& point : points) out.vertices.push_back(point.getVector3fMap());
+  for (const auto& polygon : polygons) {
+    // Triangulated output; anything else is fanned.
+    for (size_t c = 2; c < polygon.vertices.size(); ++c) {
+      out.faces.push_back({static_cast<std::int32_t>(polygon.vertices[0]),
+                           static_cast<std::int32_t>(polygon.vertices[c - 1]),
+                           static_cast<std::int32_t>(polygon.vertices[c])});
+    }
+  }
+  // Drop unused vertices, and orient the faces outward (positive enclosed volume).
+  out = KeepFaces(out, std::vector<bool>(out.faces.size(), true));
+  if (out.Volume() < 0) {
+    for (auto& face : out.faces) std::swap(face[1], face[2]);
+  }
+  out.ComputeVertexNormals();
+  if (color && mesh.HasColors() && !out.Empty()) {
+    const PointKdTree tree(mesh.vertices);
+    out.colors.resize(out.vertices.size());
+    for (size_t i = 0; i < out.vertices.size(); ++i) {
+      float distance_sq = 0;
+      out.colors[i] = mesh.colors[tree.Nearest(out.vertices[i], &distance_sq)];
+    }
+  }
+  return out;
+}
+
+MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options) {
+  options.Check();
+  MeshingResult result;
+  auto start = std::chrono::steady_clock::now();
+  result.smoothed = RemoveSmallComponents(raw, options.min_component_fraction);
+  if (!options.color) result.smoothed.colors.clear();
+  result.cleanup_ms = MillisecondsSince(start);
+  start = std::chrono::steady_clock::now();
+  SmoothHcLaplacian(&result.smoothed, options.smoothing_iterations, options.smoothing_alpha,
+                    options.smoothing_beta);
+  if (!result.smoothed.HasNormals()) result.smoothed.ComputeVertexNormals();
+  result.smoothing_ms = MillisecondsSince(start);
+  if (options.poisson) {
+    start = std::chrono::steady_clock::now();
+    // Poisson may close off stray bubbles beside the surface: they go like small pieces do.
+    result.watertight =
+        RemoveSmallComponents(PoissonReconstruct(result.smoothed, options.poisson_depth,
+                                                 options.poisson_samples_per_node, options.color),
+                              options.min_component_fraction);
+    result.poisson_ms = MillisecondsSince(start);
+  }
+  return result;
+}
+
+}  // namespace ihs::fusion

@@ -1,0 +1,66 @@
+#pragma once
+// From the TSDF's raw marching-cubes mesh to the mesh a user gets: small disconnected pieces
+// dropped (stray hand or background blobs), HC Laplacian smoothing (Vollmer, Mencl & Müller
+// 1999: Laplacian steps pulled back toward the original, so the shape does not shrink), and
+// screened Poisson reconstruction (Kazhdan et al., through PCL) into a closed, watertight mesh
+// with the colours carried over from the raw one.
+
+#include "core/triangle_mesh.h"
+
+namespace ihs::fusion {
+
+/// Options of the meshing steps (defaults: the paper's Poisson depth 10).
+struct MeshingOptions {
+  /// Connected pieces with fewer faces than this share of the largest piece's are dropped.
+  double min_component_fraction = 0.05;
+  /// HC Laplacian smoothing iterations (0: none) and its two weights: alpha pulls each step
+  /// toward the original position, beta spreads the pull-back over the neighbours (Vollmer et
+  /// al. use 0 and 0.5).
+  int smoothing_iterations = 3;
+  double smoothing_alpha = 0.0;
+  double smoothing_beta = 0.5;
+  /// Poisson reconstruction into a watertight mesh (off: the smoothed mesh is the result).
+  bool poisson = true;
+  /// Poisson octree depth (paper: 10) over the cube around the points.
+  int poisson_depth = 10;
+  /// Minimum samples per octree node: larger smooths noisy data (Kazhdan et al.: 1–5 clean,
+  /// more for noisy scans).
+  double poisson_samples_per_node = 2.0;
+  /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).
+  bool color = true;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// `mesh` without the connected pieces (through shared vertices) that have fewer faces than
+/// `min_fraction` of the largest piece; unused vertices are removed.
+TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction);
+
+/// Smooths `mesh` in place with HC Laplacian steps (Vollmer et al. 1999) over its vertex
+/// neighbourhoods; border and isolated vertices move like any other. Normals are recomputed.
+void SmoothHcLaplacian(TriangleMesh* mesh, int iterations, double alpha, double beta);
+
+/// A watertight mesh through the oriented points of `mesh` (its vertices and normals; normals are
+/// computed when missing) by Poisson reconstruction at octree `depth`. Faces are oriented
+/// outward; colours come from the nearest input vertex when `color` and the input has them.
+/// Returns an empty mesh when `mesh` has too few vertices to reconstruct from.
+TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
+                                bool color);
+
+/// The exported meshes of one raw marching-cubes mesh.
+struct MeshingResult {
+  /// Cleaned and smoothed: the TSDF's own surface (open where the object was never seen).
+  TriangleMesh smoothed;
+  /// Watertight (Poisson); empty when Poisson is off or had too few points.
+  TriangleMesh watertight;
+  /// Time spent, ms.
+  double cleanup_ms = 0;
+  double smoothing_ms = 0;
+  double poisson_ms = 0;
+};
+
+/// Runs the steps above on a raw marching-cubes mesh.
+MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options = {});
+
+}  // namespace ihs::fusion
