@@ -1,0 +1,198 @@
+#include "fusion/measure.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "core/check.h"
+#include "core/point_kd_tree.h"
+
+namespace ihs::fusion {
+namespace {
+
+// Area-weighted face centroids and unit normals of a mesh.
+struct Face {
+  Eigen::Vector3d centroid;
+  Eigen::Vector3d normal;
+  double area;
+};
+
+std::vector<Face> Faces(const TriangleMesh& mesh) {
+  std::vector<Face> faces;
+  faces.reserve(mesh.faces.size());
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>();
+    const Eigen::Vector3d b = mesh.vertices[f[1]].cast<double>();
+    const Eigen::Vector3d c = mesh.vertices[f[2]].cast<double>();
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const double twice_area = cross.norm();
+    if (twice_area <= 0) continue;
+    faces.push_back({(a + b + c) / 3, cross / twice_area, 0.5 * twice_area});
+  }
+  return faces;
+}
+
+// The distances from each of `from` to the nearest of `to`.
+std::vector<double> NearestDistances(const std::vector<Eigen::Vector3f>& from,
+                                     const std::vector<Eigen::Vector3f>& to) {
+  const PointKdTree tree(to);
+  std::vector<double> distances(from.size());
+  for (size_t i = 0; i < from.size(); ++i) {
+    float distance_sq = 0;
+    tree.Nearest(from[i], &distance_sq);
+    distances[i] = std::sqrt(distance_sq);
+  }
+  return distances;
+}
+
+double Mean(const std::vector<double>& values) {
+  double sum = 0;
+  for (double v : values) sum += v;
+  return values.empty() ? 0 : sum / values.size();
+}
+
+}  // namespace
+
+RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) {
+  IHS_CHECK_ARG(slice_mm > 0, "slice_mm must be positive, got " << slice_mm);
+  const std::vector<Face> faces = Faces(mesh);
+  IHS_CHECK_ARG(!faces.empty(), "cannot measure an empty mesh");
+  RevolutionMeasures result;
+
+  // Principal axes of the surface.
+  double total_area = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Face& f : faces) centre += f.area * f.centroid, total_area += f.area;
+  centre /= total_area;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Face& f : faces) {
+    const Eigen::Vector3d d = f.centroid - centre;
+    covariance += f.area * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / total_area);
+  const Eigen::Vector3d spread = solver.eigenvalues();  // Ascending.
+  // The axis: the eigenvalue farthest from the other two (in relative terms).
+  const double gap_low = (spread[1] - spread[0]) / std::max(spread[1], 1e-12);
+  const double gap_high = (spread[2] - spread[1]) / std::max(spread[2], 1e-12);
+  result.axis = solver.eigenvectors().col(gap_high >= gap_low ? 2 : 0).normalized();
+  result.centre = centre;
+
+  // Extent along the axis.
+  double low = INFINITY, high = -INFINITY;
+  for (const auto& v : mesh.vertices) {
+    const double h = (v.cast<double>() - centre).dot(result.axis);
+    low = std::min(low, h), high = std::max(high, h);
+  }
+  result.height_mm = high - low;
+
+  // Sections: the vertices of side faces (each with a third of the face's area), binned by
+  // height; each bin's centre, then its mean radius. Vertices lie on the surface, where face
+  // centroids would cut inside it wherever the profile curves.
+  const int bins = std::max(1, static_cast<int>(std::ceil(result.height_mm / slice_mm)));
+  std::vector<double> vertex_weight(mesh.vertices.size(), 0.0);
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>();
+    const Eigen::Vector3d cross =
+        (mesh.vertices[f[1]].cast<double>() - a).cross(mesh.vertices[f[2]].cast<double>() - a);
+    const double twice_area = cross.norm();
+    // Faces turned along the axis (flat caps) are not part of any section's outline.
+    if (twice_area <= 0 || std::abs(cross.dot(result.axis)) >= 0.7 * twice_area) continue;
+    for (int c = 0; c < 3; ++c) vertex_weight[f[c]] += twice_area / 6;
+  }
+  std::vector<double> weight(bins, 0.0), radius(bins, 0.0);
+  std::vector<Eigen::Vector3d> bin_centre(bins, Eigen::Vector3d::Zero());
+  auto bin_of = [&](const Eigen::Vector3d& p) {
+    const double h = (p - centre).dot(result.axis) - low;
+    return std::clamp(static_cast<int>(h / slice_mm), 0, bins - 1);
+  };
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (vertex_weight[i] <= 0) continue;
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    const int b = bin_of(p);
+    weight[b] += vertex_weight[i];
+    bin_centre[b] += vertex_weight[i] * p;
+  }
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    if (vertex_weight[i] <= 0) continue;
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    const int b = bin_of(p);
+    const Eigen::Vector3d d = p - bin_centre[b] / weight[b];
+    radius[b] += vertex_weight[i] * (d - d.dot(result.axis) * result.axis).norm();
+  }
+  // Bins with little surface (an end, a gap) are noise: they need a tenth of the typical bin's.
+  std::vector<double> sorted = weight;
+  std::sort(sorted.begin(), sorted.end());
+  const double min_weight = 0.1 * sorted[sorted.size() / 2];
+  for (int b = 0; b < bins; ++b) {
+    if (weight[b] <= 0 || weight[b] < min_weight) continue;
+    result.profile.push_back({(b + 0.5) * slice_mm, 2 * radius[b] / weight[b]});
+  }
+  if (result.profile.empty()) return result;
+
+  // Widest section; then, toward the farther end, the narrowest and the widest beyond it.
+  const int count = static_cast<int>(result.profile.size());
+  int widest = 0;
+  for (int i = 1; i < count; ++i) {
+    if (result.profile[i].second > result.profile[widest].second) widest = i;
+  }
+  result.widest_diameter_mm = result.profile[widest].second;
+  result.widest_at_mm = result.profile[widest].first;
+  const int step = widest < count / 2 ? 1 : -1;
+  const int end = step > 0 ? count : -1;
+  // A head: a section wider (by 5 %) than the narrowest one between it and the widest, which
+  // is a real neck (at most 80 % of the widest). The widest such section.
+  double neck = result.widest_diameter_mm;
+  for (int i = widest; i != end; i += step) {
+    const double d = result.profile[i].second;
+    neck = std::min(neck, d);
+    if (neck <= 0.8 * result.widest_diameter_mm && d > 1.05 * neck) {
+      result.head_diameter_mm = std::max(result.head_diameter_mm, d);
+    }
+  }
+  return result;
+}
+
+std::vector<Eigen::Vector3f> SampleSurface(const TriangleMesh& mesh, double spacing_mm) {
+  IHS_CHECK_ARG(spacing_mm > 0, "spacing_mm must be positive, got " << spacing_mm);
+  std::mt19937 random(12345);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  std::vector<Eigen::Vector3f> samples;
+  double carry = 0;
+  const double per_mm2 = 1.0 / (spacing_mm * spacing_mm);
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3f a = mesh.vertices[f[0]], b = mesh.vertices[f[1]], c = mesh.vertices[f[2]];
+    carry += 0.5 * (b - a).cross(c - a).norm() * per_mm2;
+    // Every face gets its share; fractions carry over to the next.
+    for (; carry >= 1; carry -= 1) {
+      float s = uniform(random), t = uniform(random);
+      if (s + t > 1) s = 1 - s, t = 1 - t;
+      samples.push_back(a + s * (b - a) + t * (c - a));
+    }
+  }
+  return samples;
+}
+
+SurfaceComparison CompareSurfaces(const TriangleMesh& scan, const TriangleMesh& truth,
+                                  double within_mm, double spacing_mm) {
+  const std::vector<Eigen::Vector3f> scan_samples = SampleSurface(scan, spacing_mm);
+  const std::vector<Eigen::Vector3f> truth_samples = SampleSurface(truth, spacing_mm);
+  IHS_CHECK_ARG(!scan_samples.empty() && !truth_samples.empty(), "cannot compare an empty surface");
+  SurfaceComparison result;
+  std::vector<double> to_truth = NearestDistances(scan_samples, truth_samples);
+  const std::vector<double> to_scan = NearestDistances(truth_samples, scan_samples);
+  result.scan_to_truth_mm = Mean(to_truth);
+  result.truth_to_scan_mm = Mean(to_scan);
+  result.chamfer_mm = 0.5 * (result.scan_to_truth_mm + result.truth_to_scan_mm);
+  std::nth_element(to_truth.begin(), to_truth.begin() + to_truth.size() * 95 / 100, to_truth.end());
+  result.scan_to_truth_p95_mm = to_truth[to_truth.size() * 95 / 100];
+  result.within_mm = within_mm;
+  result.completeness =
+      static_cast<double>(
+          std::count_if(to_scan.begin(), to_scan.end(), [&](double d) { return d <= within_mm; })) /
+      to_scan.size();
+  return result;
+}
+
+}  // namespace ihs::fusion

@@ -1,0 +1,64 @@
+#pragma once
+// Measuring a scanned mesh the way the paper does (Table 1): for a body of revolution, its
+// symmetry axis from the principal axes of its surface, its height along the axis and the
+// diameters of its sections (the widest; for a bowling pin also the head beyond the neck); and,
+// given the true surface, how far the scan is from it (Chamfer distance, completeness).
+
+#include <Eigen/Core>
+#include <utility>
+#include <vector>
+
+#include "core/triangle_mesh.h"
+
+namespace ihs::fusion {
+
+/// The dimensions of a body of revolution.
+struct RevolutionMeasures {
+  /// A point on the symmetry axis (the surface's centroid) and the axis's direction, mm.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  /// Extent along the axis, mm.
+  double height_mm = 0;
+  /// Diameter of the widest section, and where it is (height above the lower end), mm.
+  double widest_diameter_mm = 0;
+  double widest_at_mm = 0;
+  /// Where the object narrows and widens again between its widest section and its farther end
+  /// (a bowling pin's neck and head): the widest section beyond the narrowest one, mm; 0 unless
+  /// that neck is at most 80 % of the widest section and the head 5 % wider than the neck.
+  double head_diameter_mm = 0;
+  /// Section diameters along the axis: (height above the lower end, diameter), mm.
+  std::vector<std::pair<double, double>> profile;
+};
+
+/// Measures `mesh` as a body of revolution. The axis is the principal axis whose spread differs
+/// most from the other two (the long axis of a bottle, the short one of a flat disc; any for a
+/// sphere). Each section's diameter is twice the mean distance of its vertices (weighted by the
+/// area of their side faces; faces turned along the axis, such as flat caps, do not count) from
+/// the section's centre.
+/// Throws std::invalid_argument for an empty mesh or a non-positive `slice_mm`.
+RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm = 2.0);
+
+/// How well a scanned surface matches the true one (both in the same frame, mm).
+struct SurfaceComparison {
+  /// Mean distance from the scan's surface to the truth's (accuracy), from the truth's to the
+  /// scan's, and their mean (the symmetric Chamfer distance), mm.
+  double scan_to_truth_mm = 0;
+  double truth_to_scan_mm = 0;
+  double chamfer_mm = 0;
+  /// 95th percentile of scan-to-truth distances, mm.
+  double scan_to_truth_p95_mm = 0;
+  /// Share of the true surface within `within_mm` of the scan (completeness), in [0, 1].
+  double completeness = 0;
+  double within_mm = 0;
+};
+
+/// Compares two surfaces through dense samples (`spacing_mm` apart on average; the distances are
+/// biased up by about half of that).
+SurfaceComparison CompareSurfaces(const TriangleMesh& scan, const TriangleMesh& truth,
+                                  double within_mm = 2.0, double spacing_mm = 0.25);
+
+/// Points spread over the surface of `mesh`, one per `spacing_mm`² of area on average
+/// (deterministic).
+std::vector<Eigen::Vector3f> SampleSurface(const TriangleMesh& mesh, double spacing_mm);
+
+}  // namespace ihs::fusion

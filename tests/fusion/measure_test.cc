@@ -1,0 +1,88 @@
+// Measuring meshes: the paper's objects' dimensions from their true meshes in any orientation,
+// and surface comparison distances.
+
+#include "fusion/measure.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "tests/mesh_fixtures.h"
+#include "tools/synth/objects.h"
+
+namespace ihs::fusion {
+namespace {
+
+// The paper's object `name`, its profile resampled every 0.5 mm or less (a scan's mesh is
+// dense everywhere), turned and moved somewhere arbitrary.
+TriangleMesh PaperObject(const std::string& name) {
+  const synth::LatheProfile coarse = synth::PaperObjectProfile(name);
+  synth::LatheProfile profile = {coarse.front()};
+  for (size_t i = 1; i < coarse.size(); ++i) {
+    const auto [z0, r0] = coarse[i - 1];
+    const auto [z1, r1] = coarse[i];
+    const int steps = std::max(1, static_cast<int>(std::ceil(std::hypot(z1 - z0, r1 - r0) / 0.5)));
+    for (int s = 1; s <= steps; ++s) {
+      const double t = static_cast<double>(s) / steps;
+      profile.push_back({z0 + t * (z1 - z0), r0 + t * (r1 - r0)});
+    }
+  }
+  TriangleMesh mesh = synth::MakeLatheMesh(profile, 256);
+  const Eigen::Matrix3f turn =
+      Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).toRotationMatrix();
+  for (auto& v : mesh.vertices) v = turn * v + Eigen::Vector3f(12, -40, 610);
+  return mesh;
+}
+
+TEST(MeasureTest, ThePaperObjectsMeasureToTheirDimensions) {
+  struct Case {
+    std::string name;
+    double height, widest, head;
+  };
+  for (const Case& c : {Case{"water-bottle", 218, 73, 0}, Case{"small-bottle", 80, 52, 0},
+                        Case{"bowling-pin", 268, 82, 50}}) {
+    const RevolutionMeasures m = MeasureRevolution(PaperObject(c.name));
+    EXPECT_NEAR(m.height_mm, c.height, 0.5) << c.name;
+    EXPECT_NEAR(m.widest_diameter_mm, c.widest, 0.5) << c.name;
+    EXPECT_NEAR(m.head_diameter_mm, c.head, 0.5) << c.name;
+    const Eigen::Vector3d true_axis =
+        Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) * Eigen::Vector3d::UnitZ();
+    EXPECT_GT(std::abs(m.axis.dot(true_axis)), 0.999) << c.name;
+  }
+  const RevolutionMeasures sphere = MeasureRevolution(PaperObject("sphere"));
+  EXPECT_NEAR(sphere.widest_diameter_mm, 70, 0.5);
+  EXPECT_NEAR(sphere.height_mm, 70, 0.5);
+  EXPECT_THROW(MeasureRevolution(TriangleMesh{}), std::invalid_argument);
+}
+
+TEST(MeasureTest, SurfaceComparisonMeasuresTheGapAndTheCoverage) {
+  const TriangleMesh truth = test::MakeUvSphere(35, 64, 128);
+  const SurfaceComparison same = CompareSurfaces(truth, truth);
+  EXPECT_LT(same.chamfer_mm, 0.2);  // Only the sampling's own spread.
+  EXPECT_DOUBLE_EQ(same.completeness, 1.0);
+
+  const SurfaceComparison bigger = CompareSurfaces(test::MakeUvSphere(36, 64, 128), truth);
+  EXPECT_NEAR(bigger.scan_to_truth_mm, 1.0, 0.15);
+  EXPECT_NEAR(bigger.truth_to_scan_mm, 1.0, 0.15);
+  EXPECT_DOUBLE_EQ(bigger.completeness, 1.0);
+  const SurfaceComparison far = CompareSurfaces(test::MakeUvSphere(38, 64, 128), truth);
+  EXPECT_DOUBLE_EQ(far.completeness, 0.0);
+
+  // Half the sphere: half the truth is missing.
+  TriangleMesh half = truth;
+  half.faces.clear();
+  for (const auto& f : truth.faces) {
+    if (truth.vertices[f[0]].z() > 0 && truth.vertices[f[1]].z() > 0 &&
+        truth.vertices[f[2]].z() > 0) {
+      half.faces.push_back(f);
+    }
+  }
+  const SurfaceComparison partial = CompareSurfaces(half, truth);
+  EXPECT_NEAR(partial.completeness, 0.5, 0.03);
+  EXPECT_LT(partial.scan_to_truth_mm, 0.2);
+}
+
+}  // namespace
+}  // namespace ihs::fusion
