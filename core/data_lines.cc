@@ -21,4 +21,16 @@ std::vector<DataLine> ReadDataLines(const std::filesystem::path& path) {
   return lines;
 }
 
+std::vector<std::string> SplitFields(const std::string& text, char separator) {
+  std::vector<std::string> fields(1);
+  for (char c : text) {
+    if (c == separator) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
 }  // namespace ihs

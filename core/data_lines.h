@@ -20,4 +20,7 @@ struct DataLine {
 /// Throws ihs::InputError naming the path when it cannot be read.
 std::vector<DataLine> ReadDataLines(const std::filesystem::path& path);
 
+/// The fields of `text` between `separator`s ("a,,b" gives "a", "", "b"; "" gives one empty field).
+std::vector<std::string> SplitFields(const std::string& text, char separator = ',');
+
 }  // namespace ihs

@@ -10,6 +10,15 @@
 #include "core/check.h"
 
 namespace ihs::fusion {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
 
 const char* ToString(FusionStatus status) {
   switch (status) {
@@ -38,7 +47,7 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       volume_(options_.tsdf) {}
 
 FusionResult ObjectFusion::Fuse(const FusionInput& input) {
-  const auto started_at = std::chrono::steady_clock::now();
+  const auto started_at = Clock::now();
   IHS_CHECK_ARG(input.frame != nullptr && input.object_mask != nullptr,
                 "Fuse needs a frame and its object mask");
   const Frame& frame = *input.frame;
@@ -49,9 +58,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   auto finish = [&](FusionStatus status, std::string reason = {}) {
     result.status = status;
     result.reason = std::move(reason);
-    result.milliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started_at)
-            .count();
+    result.milliseconds = MillisecondsSince(started_at);
     return std::move(result);
   };
 
@@ -80,14 +87,18 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     centre /= static_cast<double>(points.size());
     cam_from_object_ = Rigid3::Translation(centre);
     result.cam_from_object = cam_from_object_;
+    const auto integrate_start = Clock::now();
     result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, cam_from_object_);
+    result.integrate_ms = MillisecondsSince(integrate_start);
     started_ = true;
     return finish(FusionStatus::kStarted);
   }
 
   // The correspondences' motion, then ICP from there.
   Rigid3 pose = cam_from_object_;
+  const auto pairwise_start = Clock::now();
   result.pairwise = RegisterPair(input.correspondences, options_.pairwise);
+  result.pairwise_ms = MillisecondsSince(pairwise_start);
   if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
   if (options_.use_icp) {
     // The model where the object was, grown by the largest plausible jump.
@@ -104,8 +115,12 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
                            options_.pairwise.contact_weight});
       }
     }
-    result.icp = AlignToModel(points, volume_.Raycast(intrinsics_, pose, roi), intrinsics_, pose,
-                              options_.icp, anchors);
+    const auto raycast_start = Clock::now();
+    const RaycastImage model = volume_.Raycast(intrinsics_, pose, roi);
+    result.raycast_ms = MillisecondsSince(raycast_start);
+    const auto icp_start = Clock::now();
+    result.icp = AlignToModel(points, model, intrinsics_, pose, options_.icp, anchors);
+    result.icp_ms = MillisecondsSince(icp_start);
     if (result.icp.ok) {
       pose = result.icp.cam_from_volume;
     } else if (!result.pairwise.ok) {
@@ -128,7 +143,9 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   }
   cam_from_object_ = pose;
   result.cam_from_object = pose;
+  const auto integrate_start = Clock::now();
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
+  result.integrate_ms = MillisecondsSince(integrate_start);
   return finish(FusionStatus::kFused);
 }
 

@@ -67,7 +67,13 @@ struct FusionResult {
   PairwiseResult pairwise;
   IcpResult icp;
   int integrated_voxels = 0;
+  /// Time spent, ms: in all, and on the pairwise solve, the model's raycast, ICP and the
+  /// integration.
   double milliseconds = 0;
+  double pairwise_ms = 0;
+  double raycast_ms = 0;
+  double icp_ms = 0;
+  double integrate_ms = 0;
 };
 
 /// Registers and fuses an object frame by frame. Not thread-safe; the fusion thread owns it.

@@ -1,5 +1,6 @@
 #include "fusion/sift_matcher.h"
 
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -25,7 +26,8 @@ SiftMatcher::SiftMatcher(const CameraIntrinsics& intrinsics, SiftOptions options
     : intrinsics_(intrinsics),
       options_((options.Check(), options)),
       state_(std::make_unique<State>()) {
-  state_->sift = cv::SIFT::create(options_.max_features);
+  // OpenCV's defaults but the edge threshold, which the authors' configuration raises to 15.
+  state_->sift = cv::SIFT::create(options_.max_features, 3, 0.04, 15.0, 1.6);
 }
 
 SiftMatcher::~SiftMatcher() = default;
@@ -39,16 +41,36 @@ std::vector<PointMatch> SiftMatcher::Match(const Frame& frame,
     state_->has_previous = false;
     return matches;
   }
-  cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
-  cv::Mat gray;
-  cv::cvtColor(rgb, gray, cv::COLOR_RGB2GRAY);
-  cv::Mat mask(frame.height, frame.width, CV_8U);
-  for (int pixel = 0; pixel < frame.PixelCount(); ++pixel) {
-    mask.data[pixel] = object_mask[pixel] && frame.depth_mm[pixel] != 0 ? 255 : 0;
+  // Only the object's bounding box (with room for the descriptors' support) is searched.
+  int u0 = frame.width, v0 = frame.height, u1 = -1, v1 = -1;
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const int pixel = v * frame.width + u;
+      if (!object_mask[pixel] || frame.depth_mm[pixel] == 0) continue;
+      u0 = std::min(u0, u), v0 = std::min(v0, v), u1 = std::max(u1, u), v1 = std::max(v1, v);
+    }
   }
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
-  state_->sift->detectAndCompute(gray, mask, keypoints, descriptors);
+  if (u1 >= u0) {
+    constexpr int kPad = 16;
+    const cv::Rect box =
+        cv::Rect(u0 - kPad, v0 - kPad, u1 - u0 + 1 + 2 * kPad, v1 - v0 + 1 + 2 * kPad) &
+        cv::Rect(0, 0, frame.width, frame.height);
+    const cv::Mat rgb(frame.height, frame.width, CV_8UC3,
+                      const_cast<std::uint8_t*>(frame.rgb.data()));
+    cv::Mat gray;
+    cv::cvtColor(rgb(box), gray, cv::COLOR_RGB2GRAY);
+    cv::Mat mask(box.height, box.width, CV_8U);
+    for (int v = 0; v < box.height; ++v) {
+      for (int u = 0; u < box.width; ++u) {
+        const int pixel = (v + box.y) * frame.width + u + box.x;
+        mask.at<std::uint8_t>(v, u) = object_mask[pixel] && frame.depth_mm[pixel] != 0 ? 255 : 0;
+      }
+    }
+    state_->sift->detectAndCompute(gray, mask, keypoints, descriptors);
+    for (auto& keypoint : keypoints) keypoint.pt += cv::Point2f(box.x, box.y);
+  }
   // Keypoints with depth at their (rounded) position, back-projected.
   std::vector<Eigen::Vector3d> points;
   cv::Mat kept;

@@ -1,11 +1,17 @@
 #include "fusion/surface_mesh.h"
 
+#include <fcntl.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/surface/poisson.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <mutex>
 #include <numeric>
 #include <vector>
 
@@ -49,6 +55,32 @@ TriangleMesh KeepFaces(const TriangleMesh& mesh, const std::vector<bool>& keep) 
   }
   return out;
 }
+
+// Sends what is written to stdout to /dev/null while it lives (PCL's Poisson prints its
+// diagnostics with printf). The project writes nothing to stdout while meshing: logs go to
+// stderr.
+class SilencedStdout {
+ public:
+  SilencedStdout() {
+    std::fflush(stdout);
+    saved_ = dup(STDOUT_FILENO);
+    const int null = open("/dev/null", O_WRONLY);
+    if (saved_ >= 0 && null >= 0) dup2(null, STDOUT_FILENO);
+    if (null >= 0) close(null);
+  }
+  ~SilencedStdout() {
+    std::fflush(stdout);
+    if (saved_ >= 0) {
+      dup2(saved_, STDOUT_FILENO);
+      close(saved_);
+    }
+  }
+  SilencedStdout(const SilencedStdout&) = delete;
+  SilencedStdout& operator=(const SilencedStdout&) = delete;
+
+ private:
+  int saved_ = -1;
+};
 
 }  // namespace
 
@@ -131,6 +163,61 @@ void SmoothHcLaplacian(TriangleMesh* mesh, int iterations, double alpha, double 
   mesh->ComputeVertexNormals();
 }
 
+int FillHoles(TriangleMesh* mesh) {
+  // Directed edges with no opposite twin are the holes' borders; the fill walks them backwards.
+  std::map<std::pair<std::int32_t, std::int32_t>, int> directed;
+  for (const auto& face : mesh->faces) {
+    for (int c = 0; c < 3; ++c) ++directed[{face[c], face[(c + 1) % 3]}];
+  }
+  std::multimap<std::int32_t, std::int32_t> border;  // a → b for each border edge a→b.
+  for (const auto& [edge, count] : directed) {
+    if (count == 1 && !directed.count({edge.second, edge.first})) {
+      border.emplace(edge.first, edge.second);
+    }
+  }
+  int holes = 0;
+  while (!border.empty()) {
+    // Follow the border from one edge until it comes back.
+    std::vector<std::int32_t> loop;
+    auto edge = border.begin();
+    const std::int32_t start = edge->first;
+    bool closed = false;
+    for (std::int32_t at = start;;) {
+      loop.push_back(at);
+      at = edge->second;
+      border.erase(edge);
+      if ((closed = at == start)) break;
+      edge = border.find(at);
+      if (edge == border.end()) break;  // Not a closed loop (a non-manifold border): left.
+    }
+    if (!closed || loop.size() < 3) continue;
+    // A fan around the centroid, each triangle against one border edge.
+    const auto centre = static_cast<std::int32_t>(mesh->vertices.size());
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero(), normal = Eigen::Vector3f::Zero();
+    Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
+    for (std::int32_t v : loop) {
+      sum += mesh->vertices[v];
+      if (mesh->HasNormals()) normal += mesh->normals[v];
+      if (mesh->HasColors()) {
+        for (int c = 0; c < 3; ++c) rgb[c] += mesh->colors[v][c];
+      }
+    }
+    const float n = static_cast<float>(loop.size());
+    mesh->vertices.push_back(sum / n);
+    if (mesh->HasNormals()) mesh->normals.push_back(normal.normalized());
+    if (mesh->HasColors()) {
+      mesh->colors.push_back({static_cast<std::uint8_t>(std::lround(rgb[0] / n)),
+                              static_cast<std::uint8_t>(std::lround(rgb[1] / n)),
+                              static_cast<std::uint8_t>(std::lround(rgb[2] / n))});
+    }
+    for (size_t i = 0; i < loop.size(); ++i) {
+      mesh->faces.push_back({loop[(i + 1) % loop.size()], loop[i], centre});
+    }
+    ++holes;
+  }
+  return holes;
+}
+
 TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
                                 bool color) {
   constexpr size_t kMinPoints = 16;
@@ -158,7 +245,12 @@ TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samp
   poisson.setInputCloud(cloud);
   pcl::PointCloud<pcl::PointNormal> points;
   std::vector<pcl::Vertices> polygons;
-  poisson.reconstruct(points, polygons);
+  {
+    static std::mutex stdout_mutex;
+    const std::lock_guard<std::mutex> lock(stdout_mutex);
+    const SilencedStdout silenced;
+    poisson.reconstruct(points, polygons);
+  }
 
   TriangleMesh out;
   out.vertices.reserve(points.size());
@@ -171,8 +263,10 @@ TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samp
                            static_cast<std::int32_t>(polygon.vertices[c])});
     }
   }
-  // Drop unused vertices, and orient the faces outward (positive enclosed volume).
+  // Drop unused vertices, close what PCL left open, and orient the faces outward (positive
+  // enclosed volume).
   out = KeepFaces(out, std::vector<bool>(out.faces.size(), true));
+  FillHoles(&out);
   if (out.Volume() < 0) {
     for (auto& face : out.faces) std::swap(face[1], face[2]);
   }

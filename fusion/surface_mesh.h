@@ -41,9 +41,16 @@ TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction
 /// neighbourhoods; border and isolated vertices move like any other. Normals are recomputed.
 void SmoothHcLaplacian(TriangleMesh* mesh, int iterations, double alpha, double beta);
 
+/// Closes each hole of `mesh` (a loop of edges with a face on one side only) with a fan of
+/// triangles around a new vertex at the loop's centroid (colour and normal averaged from the
+/// loop). Returns the number of holes closed.
+int FillHoles(TriangleMesh* mesh);
+
 /// A watertight mesh through the oriented points of `mesh` (its vertices and normals; normals are
 /// computed when missing) by Poisson reconstruction at octree `depth`. Faces are oriented
 /// outward; colours come from the nearest input vertex when `color` and the input has them.
+/// PCL's extraction now and then drops a triangle whose edge it cannot match (printing "Vertex
+/// pair not in list" to stdout, which is kept out of ours): the small holes left are filled.
 /// Returns an empty mesh when `mesh` has too few vertices to reconstruct from.
 TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
                                 bool color);

@@ -37,6 +37,7 @@ void TsdfOptions::Check() const {
 TsdfVolume::TsdfVolume(TsdfOptions options)
     : options_((options.Check(), options)),
       n_(options_.resolution),
+      observed_lo_{n_, n_, n_},
       voxel_mm_(options_.size_mm / options_.resolution),
       truncation_mm_(options_.truncation_voxels * voxel_mm_),
       voxels_(static_cast<size_t>(n_) * n_ * n_) {}
@@ -126,6 +127,11 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
     }
     voxel_ref.weight =
         static_cast<std::uint16_t>(std::min<int>(options_.max_weight, voxel_ref.weight + 1));
+    const int ijk[3] = {i, j, k};
+    for (int a = 0; a < 3; ++a) {
+      observed_lo_[a] = std::min(observed_lo_[a], ijk[a]);
+      observed_hi_[a] = std::max(observed_hi_[a], ijk[a]);
+    }
     ++updated;
   }
   return updated;
@@ -166,6 +172,13 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
   const Eigen::Matrix3f to_cam = cam_from_volume.rotation().cast<float>();
   const float half = static_cast<float>(0.5 * options_.size_mm);
   const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
+  if (observed_hi_[0] < observed_lo_[0]) return image;  // Nothing to see yet.
+  // Rays are followed only through the box of observed voxels.
+  Eigen::Vector3f box_lo, box_hi;
+  for (int a = 0; a < 3; ++a) {
+    box_lo[a] = -half + observed_lo_[a] * voxel;
+    box_hi[a] = -half + (observed_hi_[a] + 1) * voxel;
+  }
   const bool whole = roi[2] <= roi[0] || roi[3] <= roi[1];
   const int u0 = whole ? 0 : std::max(0, roi[0]), v0 = whole ? 0 : std::max(0, roi[1]);
   const int u1 = whole ? image.width : std::min(image.width, roi[2]);
@@ -178,10 +191,10 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
       float t_near = 0, t_far = std::numeric_limits<float>::infinity();
       for (int a = 0; a < 3; ++a) {
         if (std::abs(ray[a]) < 1e-9f) {
-          if (std::abs(origin[a]) > half) t_far = -1;
+          if (origin[a] < box_lo[a] || origin[a] > box_hi[a]) t_far = -1;
           continue;
         }
-        float t0 = (-half - origin[a]) / ray[a], t1 = (half - origin[a]) / ray[a];
+        float t0 = (box_lo[a] - origin[a]) / ray[a], t1 = (box_hi[a] - origin[a]) / ray[a];
         if (t0 > t1) std::swap(t0, t1);
         t_near = std::max(t_near, t0), t_far = std::min(t_far, t1);
       }

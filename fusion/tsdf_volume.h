@@ -93,6 +93,9 @@ class TsdfVolume {
 
   const TsdfOptions options_;
   const int n_;
+  // Index bounds (inclusive) of the voxels updated so far; lo > hi while none is.
+  std::array<int, 3> observed_lo_;
+  std::array<int, 3> observed_hi_ = {-1, -1, -1};
   const double voxel_mm_;
   const double truncation_mm_;
   std::vector<Voxel> voxels_;

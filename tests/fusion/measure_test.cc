@@ -18,17 +18,7 @@ namespace {
 // The paper's object `name`, its profile resampled every 0.5 mm or less (a scan's mesh is
 // dense everywhere), turned and moved somewhere arbitrary.
 TriangleMesh PaperObject(const std::string& name) {
-  const synth::LatheProfile coarse = synth::PaperObjectProfile(name);
-  synth::LatheProfile profile = {coarse.front()};
-  for (size_t i = 1; i < coarse.size(); ++i) {
-    const auto [z0, r0] = coarse[i - 1];
-    const auto [z1, r1] = coarse[i];
-    const int steps = std::max(1, static_cast<int>(std::ceil(std::hypot(z1 - z0, r1 - r0) / 0.5)));
-    for (int s = 1; s <= steps; ++s) {
-      const double t = static_cast<double>(s) / steps;
-      profile.push_back({z0 + t * (z1 - z0), r0 + t * (r1 - r0)});
-    }
-  }
+  const synth::LatheProfile profile = synth::ResampleProfile(synth::PaperObjectProfile(name), 0.5);
   TriangleMesh mesh = synth::MakeLatheMesh(profile, 256);
   const Eigen::Matrix3f turn =
       Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).toRotationMatrix();

@@ -83,6 +83,21 @@ TEST(SurfaceMeshTest, HcLaplacianSmoothsNoiseWithoutShrinking) {
   EXPECT_LT(RadiusStats(plain).first, mean_after - 0.05);
 }
 
+TEST(SurfaceMeshTest, HolesAreClosedIntoAWatertightMesh) {
+  TriangleMesh mesh = test::MakeUvSphere(35, 24, 48);
+  // Three holes: one face, two adjacent faces, and a face far from both.
+  for (size_t f : {400u, 301u, 300u, 100u}) mesh.faces.erase(mesh.faces.begin() + f);
+  ASSERT_FALSE(mesh.IsWatertight());
+  mesh.colors.assign(mesh.vertices.size(), {10, 20, 30});
+  const size_t faces = mesh.faces.size();
+  EXPECT_EQ(FillHoles(&mesh), 3);
+  EXPECT_TRUE(mesh.IsWatertight());
+  EXPECT_EQ(mesh.faces.size(), faces + 3 + 4 + 3);  // A fan of one face per border edge.
+  EXPECT_EQ(mesh.colors.back(), (TriangleMesh::Color{10, 20, 30}));
+  mesh.Check();
+  EXPECT_EQ(FillHoles(&mesh), 0);
+}
+
 TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
   const TriangleMesh sphere = test::MakeUvSphere(35, 48, 96);
   // Cut off the cap above z = 25 mm: a hole of about 50 mm across.

@@ -46,17 +46,7 @@ ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& prof
     shape.mesh_ = MakeLatheMesh(profile, kLatheSegments, rgb);
   } else {
     // A profile sampled every 2 mm, so the pattern's edges stay sharp, then a checkerboard.
-    LatheProfile dense;
-    for (size_t i = 0; i + 1 < profile.size(); ++i) {
-      const auto [z0, r0] = profile[i];
-      const auto [z1, r1] = profile[i + 1];
-      const int steps =
-          std::max(1, static_cast<int>(std::ceil(std::hypot(z1 - z0, r1 - r0) / 2.0)));
-      for (int k = 0; k < steps; ++k) {
-        dense.emplace_back(z0 + (z1 - z0) * k / steps, r0 + (r1 - r0) * k / steps);
-      }
-    }
-    dense.push_back(profile.back());
+    const LatheProfile dense = ResampleProfile(profile, 2.0);
     shape.mesh_ = MakeLatheMesh(dense, kLatheSegments, rgb);
     for (size_t v = 0; v < shape.mesh_.vertices.size(); ++v) {
       const Eigen::Vector3f& p = shape.mesh_.vertices[v];

@@ -1,7 +1,9 @@
 #include "tools/synth/objects.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/check.h"
 #include "core/data_lines.h"
@@ -61,6 +63,22 @@ LatheProfile PaperObjectProfile(const std::string& name) {
   }
   Check(p, name);
   return p;
+}
+
+LatheProfile ResampleProfile(const LatheProfile& profile, double max_step_mm) {
+  if (!(max_step_mm > 0)) throw std::invalid_argument("max_step_mm must be positive");
+  LatheProfile dense;
+  for (size_t i = 0; i + 1 < profile.size(); ++i) {
+    const auto [z0, r0] = profile[i];
+    const auto [z1, r1] = profile[i + 1];
+    const int steps =
+        std::max(1, static_cast<int>(std::ceil(std::hypot(z1 - z0, r1 - r0) / max_step_mm)));
+    for (int k = 0; k < steps; ++k) {
+      dense.emplace_back(z0 + (z1 - z0) * k / steps, r0 + (r1 - r0) * k / steps);
+    }
+  }
+  if (!profile.empty()) dense.push_back(profile.back());
+  return dense;
 }
 
 LatheProfile ReadLatheProfile(const std::filesystem::path& path) {

@@ -28,6 +28,10 @@ std::vector<std::string> PaperObjectNames();
 /// file and line when malformed (fewer than 2 points, negative radius, decreasing height).
 LatheProfile ReadLatheProfile(const std::filesystem::path& path);
 
+/// `profile` with points added along each segment, so that none is longer than `max_step_mm`
+/// (the shape is unchanged; its mesh gets rings that dense).
+LatheProfile ResampleProfile(const LatheProfile& profile, double max_step_mm);
+
 /// Revolves `profile` about +z with `segments` around: a closed, outward mesh with normals and
 /// a uniform colour `rgb`.
 TriangleMesh MakeLatheMesh(const LatheProfile& profile, int segments,

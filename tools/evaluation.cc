@@ -1,0 +1,216 @@
+#include "tools/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "core/data_lines.h"
+#include "core/errors.h"
+#include "core/mesh_io.h"
+#include "core/point_kd_tree.h"
+#include "tools/synth/objects.h"
+#include "tracker/hand_joints_io.h"
+
+namespace ihs::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+synth::LatheProfile ProfileOf(const std::string& spec) {
+  if (spec.rfind("lathe:", 0) == 0) return synth::ReadLatheProfile(spec.substr(6));
+  return synth::PaperObjectProfile(spec);  // Throws for an unknown name.
+}
+
+// The generator's fingertips, in contacts.csv's column order, and each one's joint in
+// hand_joints.csv (the end of its last bone: "RFing.<f>_…" columns, thumb = finger 4).
+constexpr const char* kFingers[5] = {"pinky", "ring", "middle", "index", "thumb"};
+
+// Per frame of gt/contacts.csv: whether each fingertip touches the object.
+std::map<std::int64_t, std::array<bool, 5>> ReadTouches(const fs::path& path) {
+  const std::vector<DataLine> lines = ReadDataLines(path);
+  if (lines.empty()) throw InputError(path.string() + ": empty");
+  const std::vector<std::string> header = SplitFields(lines.front().text);
+  std::array<int, 5> column{};
+  for (int f = 0; f < 5; ++f) {
+    const auto found = std::find(header.begin(), header.end(), std::string(kFingers[f]) + "_touch");
+    if (found == header.end()) {
+      throw InputError(path.string() + ": no column " + kFingers[f] + "_touch");
+    }
+    column[f] = static_cast<int>(found - header.begin());
+  }
+  std::map<std::int64_t, std::array<bool, 5>> touches;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> fields = SplitFields(lines[i].text);
+    if (fields.size() != header.size()) {
+      throw InputError(path.string() + ": line " + std::to_string(lines[i].number) + " has " +
+                       std::to_string(fields.size()) + " fields, the header " +
+                       std::to_string(header.size()));
+    }
+    std::array<bool, 5> touch{};
+    for (int f = 0; f < 5; ++f) touch[f] = fields[column[f]] == "1";
+    touches[std::stoll(fields[0])] = touch;
+  }
+  return touches;
+}
+
+// The joint index (in a hand_joints.csv row) of each fingertip: the last joint of finger f.
+std::array<int, 5> FingertipJoints(const fs::path& joints_csv) {
+  const std::vector<DataLine> lines = ReadDataLines(joints_csv);
+  if (lines.empty()) throw InputError(joints_csv.string() + ": empty");
+  std::array<int, 5> joint;
+  joint.fill(-1);
+  // Columns: frame, then x,y,z per joint.
+  const std::vector<std::string> header = SplitFields(lines.front().text);
+  for (size_t column = 1; column < header.size(); ++column) {
+    for (int f = 0; f < 5; ++f) {
+      const std::string prefix = "RFing." + std::to_string(f) + "_";
+      if (header[column].rfind(prefix, 0) == 0) joint[f] = static_cast<int>(column - 1) / 3;
+    }
+  }
+  for (int f = 0; f < 5; ++f) {
+    if (joint[f] < 0) {
+      throw InputError(joints_csv.string() + ": no joints of finger RFing." + std::to_string(f));
+    }
+  }
+  return joint;
+}
+
+}  // namespace
+
+const StampedPose* FindPose(const std::vector<StampedPose>& trajectory, double time_s) {
+  const auto found =
+      std::lower_bound(trajectory.begin(), trajectory.end(), time_s - 5e-4,
+                       [](const StampedPose& pose, double t) { return pose.time_s < t; });
+  if (found == trajectory.end() || std::abs(found->time_s - time_s) > 5e-4) return nullptr;
+  return &*found;
+}
+
+fusion::RevolutionMeasures TrueMeasures(const std::string& object_spec) {
+  // Rings every 0.5 mm, as dense as a scan's mesh, so the same measuring code applies.
+  return fusion::MeasureRevolution(
+      synth::MakeLatheMesh(synth::ResampleProfile(ProfileOf(object_spec), 0.5), 256));
+}
+
+double TrueVolume(const std::string& object_spec) {
+  const synth::LatheProfile profile = ProfileOf(object_spec);
+  double volume = 0;
+  for (size_t i = 1; i < profile.size(); ++i) {
+    const auto [z0, r0] = profile[i - 1];
+    const auto [z1, r1] = profile[i];
+    volume += M_PI * (z1 - z0) * (r0 * r0 + r0 * r1 + r1 * r1) / 3;
+  }
+  return volume;
+}
+
+std::vector<DimensionRow> PaperDimensions(const std::string& object_spec,
+                                          const TriangleMesh& scan) {
+  const fusion::RevolutionMeasures truth = TrueMeasures(object_spec);
+  const fusion::RevolutionMeasures captured = fusion::MeasureRevolution(scan);
+  if (object_spec == "sphere") {
+    return {{"diameter", truth.widest_diameter_mm, captured.widest_diameter_mm}};
+  }
+  std::vector<DimensionRow> rows = {{"height", truth.height_mm, captured.height_mm}};
+  if (object_spec == "bowling-pin") {
+    rows.push_back({"body diameter", truth.widest_diameter_mm, captured.widest_diameter_mm});
+    rows.push_back({"head diameter", truth.head_diameter_mm, captured.head_diameter_mm});
+  } else {
+    rows.push_back({"diameter", truth.widest_diameter_mm, captured.widest_diameter_mm});
+  }
+  return rows;
+}
+
+PairwiseError ContactPairwiseError(const fs::path& gt_dir,
+                                   const std::vector<StampedPose>& trajectory) {
+  const std::vector<StampedPose> truth = ReadTumTrajectory(gt_dir / "trajectory.txt");
+  const auto touches = ReadTouches(gt_dir / "contacts.csv");
+  const std::array<int, 5> tip = FingertipJoints(gt_dir / "hand_joints.csv");
+  const std::vector<tracker::HandJointsRow> joints =
+      tracker::ReadHandJointsCsv(gt_dir / "hand_joints.csv");
+  const TriangleMesh object = ReadMesh(gt_dir / "object.ply");
+  const PointKdTree surface(fusion::SampleSurface(object, 0.3));
+
+  std::vector<double> errors;
+  for (size_t k = 1; k < truth.size() && k < joints.size(); ++k) {
+    const StampedPose* before = FindPose(trajectory, truth[k - 1].time_s);
+    const StampedPose* after = FindPose(trajectory, truth[k].time_s);
+    const auto touch_before = touches.find(static_cast<std::int64_t>(k - 1));
+    const auto touch_after = touches.find(static_cast<std::int64_t>(k));
+    if (!before || !after || touch_before == touches.end() || touch_after == touches.end()) {
+      continue;
+    }
+    const Rigid3 estimated = after->transform * before->transform.Inverse();
+    const Rigid3 object_from_cam = truth[k - 1].transform.Inverse();
+    for (int f = 0; f < 5; ++f) {
+      if (!touch_before->second[f] || !touch_after->second[f]) continue;
+      // The object's surface point under the fingertip, in the object frame.
+      float distance_sq = 0;
+      const Eigen::Vector3f tip_in_object =
+          (object_from_cam * joints[k - 1].joints_mm[tip[f]]).cast<float>();
+      const Eigen::Vector3d point =
+          surface.points()[surface.Nearest(tip_in_object, &distance_sq)].cast<double>();
+      const Eigen::Vector3d seen_before = truth[k - 1].transform * point;
+      errors.push_back((estimated * seen_before - truth[k].transform * point).norm());
+    }
+  }
+  PairwiseError result;
+  result.samples = static_cast<int>(errors.size());
+  if (errors.empty()) return result;
+  double sum = 0, sum_sq = 0;
+  for (double e : errors) sum += e, sum_sq += e * e;
+  result.mean_mm = sum / errors.size();
+  result.std_mm =
+      std::sqrt(std::max(0.0, sum_sq / errors.size() - result.mean_mm * result.mean_mm));
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  result.median_mm = errors[errors.size() / 2];
+  return result;
+}
+
+TrajectoryError CompareTrajectory(const fs::path& gt_dir,
+                                  const std::vector<StampedPose>& trajectory) {
+  const std::vector<StampedPose> truth = ReadTumTrajectory(gt_dir / "trajectory.txt");
+  const TriangleMesh object = ReadMesh(gt_dir / "object.ply");
+  TrajectoryError result;
+  if (trajectory.empty()) return result;
+  const StampedPose* first = FindPose(truth, trajectory.front().time_s);
+  if (!first) return result;
+  // Scan object frame ← true object frame, fixed by the first registered frame.
+  const Rigid3 scan_from_truth = trajectory.front().transform.Inverse() * first->transform;
+  double sum = 0;
+  for (const StampedPose& pose : trajectory) {
+    const StampedPose* true_pose = FindPose(truth, pose.time_s);
+    if (!true_pose) continue;
+    const Rigid3 estimated = pose.transform * scan_from_truth;
+    double error = 0;
+    for (const auto& v : object.vertices) {
+      const Eigen::Vector3d p = v.cast<double>();
+      error += (estimated * p - true_pose->transform * p).norm();
+    }
+    error /= std::max<size_t>(1, object.vertices.size());
+    sum += error;
+    result.max_mm = std::max(result.max_mm, error);
+    result.final_mm = error;
+    ++result.frames;
+  }
+  result.mean_mm = result.frames ? sum / result.frames : 0;
+  return result;
+}
+
+fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const TriangleMesh& scan,
+                                           const std::vector<StampedPose>& trajectory) {
+  if (trajectory.empty()) throw InputError("no registered frame to align the scan by");
+  const std::vector<StampedPose> truth = ReadTumTrajectory(gt_dir / "trajectory.txt");
+  const StampedPose* true_pose = FindPose(truth, trajectory.front().time_s);
+  if (!true_pose) {
+    throw InputError((gt_dir / "trajectory.txt").string() +
+                     ": no pose at t = " + std::to_string(trajectory.front().time_s) + " s");
+  }
+  // Scan object frame → camera (first registered frame) → true object frame.
+  const Rigid3 truth_from_scan = true_pose->transform.Inverse() * trajectory.front().transform;
+  TriangleMesh placed = scan;
+  for (auto& v : placed.vertices)
+    v = (truth_from_scan * Eigen::Vector3d(v.cast<double>())).cast<float>();
+  return fusion::CompareSurfaces(placed, ReadMesh(gt_dir / "object.ply"));
+}
+
+}  // namespace ihs::eval

@@ -1,0 +1,76 @@
+#pragma once
+// Evaluating a scan against a generator's ground truth the way the paper does: Table 1 (the
+// objects' dimensions), Table 2 (pairwise registration error at the fingertip contact points),
+// and the surface's Chamfer distance and completeness after aligning by the known trajectory.
+// Shared by inhandscan-scan, inhandscan-measure and the benchmark.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/trajectory_io.h"
+#include "core/triangle_mesh.h"
+#include "fusion/measure.h"
+
+namespace ihs::eval {
+
+/// One of the paper's Table 1 measures.
+struct DimensionRow {
+  std::string measure;  ///< e.g. "diameter", "height", "head diameter".
+  double truth_mm = 0;
+  double captured_mm = 0;
+  double Error() const { return captured_mm - truth_mm; }
+};
+
+/// The paper's measures of an object ("sphere": diameter; the bottles: height and diameter;
+/// "bowling-pin": height, body and head diameters; any other body of revolution: height and
+/// widest diameter), truth from `object_spec` (a paper object's name or `lathe:FILE`) and the
+/// captured values measured on `scan`. Throws std::invalid_argument for an unknown object.
+std::vector<DimensionRow> PaperDimensions(const std::string& object_spec, const TriangleMesh& scan);
+
+/// The true dimensions of `object_spec`, measured on its densely resampled lathe mesh by the
+/// same code that measures scans.
+fusion::RevolutionMeasures TrueMeasures(const std::string& object_spec);
+
+/// The volume enclosed by `object_spec`'s profile revolved (frustum by frustum), mm³.
+double TrueVolume(const std::string& object_spec);
+
+/// Pairwise registration error at the fingertip contact points (the paper's Table 2): for every
+/// pair of consecutive frames both registered by the scan, and every fingertip touching the
+/// object in both (ground truth), the object's surface point under that fingertip is carried
+/// from the first frame to the second by the scan's relative motion and by the true one; the
+/// error is the distance between the two.
+struct PairwiseError {
+  double mean_mm = 0;
+  double std_mm = 0;
+  double median_mm = 0;
+  int samples = 0;
+};
+
+/// `gt_dir`: a generator's gt/ folder; `trajectory`: the scan's cam_from_object per registered
+/// frame, stamped with the frames' timestamps.
+PairwiseError ContactPairwiseError(const std::filesystem::path& gt_dir,
+                                   const std::vector<StampedPose>& trajectory);
+
+/// The scan (object frame of the scan) against the true object, placed into the true object's
+/// frame by the first registered frame: Chamfer distance and completeness.
+fusion::SurfaceComparison CompareWithTruth(const std::filesystem::path& gt_dir,
+                                           const TriangleMesh& scan,
+                                           const std::vector<StampedPose>& trajectory);
+
+/// Drift of the scan's object trajectory: at every registered frame, how far the true object's
+/// surface points are from where the scan puts them, both trajectories tied together at the
+/// first registered frame (mean over the object's vertices), mm.
+struct TrajectoryError {
+  double mean_mm = 0;
+  double max_mm = 0;
+  double final_mm = 0;
+  int frames = 0;
+};
+TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
+                                  const std::vector<StampedPose>& trajectory);
+
+/// The pose of `trajectory` stamped `time_s` (within half a millisecond), or nullptr.
+const StampedPose* FindPose(const std::vector<StampedPose>& trajectory, double time_s);
+
+}  // namespace ihs::eval
