@@ -13,6 +13,7 @@ void IcpOptions::Check() const {
   IHS_CHECK_ARG(max_distance_mm > 0, "icp.max_distance_mm must be positive");
   IHS_CHECK_ARG(min_inlier_fraction >= 0 && min_inlier_fraction <= 1,
                 "icp.min_inlier_fraction must be in [0, 1]");
+  IHS_CHECK_ARG(anchor_share >= 0, "icp.anchor_share must be >= 0");
 }
 
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
@@ -32,9 +33,19 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   const double max_sq = options.max_distance_mm * options.max_distance_mm;
   double rms = 0;
   int inliers = 0;
+  // The twist is taken about the points' centroid, with the turn scaled by their spread, so
+  // that turns and shifts weigh alike and a sphere's free turn is a clean null direction.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& point : points) centroid += point.cast<double>();
+  centroid /= std::max<size_t>(1, points.size());
+  double spread_sq = 0;
+  for (const Eigen::Vector3f& point : points)
+    spread_sq += (point.cast<double>() - centroid).squaredNorm();
+  const double scale = std::max(1.0, std::sqrt(spread_sq / std::max<size_t>(1, points.size())));
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
     Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    const Eigen::Vector3d centre = correction * centroid;
     double sum_sq = 0;
     inliers = 0;
     for (const Eigen::Vector3f& point : points) {
@@ -51,35 +62,44 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       const Eigen::Vector3d target = intrinsics.BackProject(u, v, depth);
       if ((p - target).squaredNorm() > max_sq) continue;
       const double residual = normal.dot(p - target);
-      // d(residual)/d(ω, t) for p ← exp(ω)·p + t: (p × n, n).
+      // d(residual)/d(θ, t) for p ← exp(θ / scale)·(p − c) + c + t: ((p − c) / scale × n, n).
       Eigen::Matrix<double, 6, 1> row;
-      row << p.cross(normal), normal;
+      row << ((p - centre) / scale).cross(normal), normal;
       normal_matrix += row * row.transpose();
       rhs -= row * residual;
       sum_sq += residual * residual;
       ++inliers;
     }
     rms = inliers > 0 ? std::sqrt(sum_sq / inliers) : 0;
+    // The anchors together weigh `anchor_share` of the surface's pairs: they decide what the
+    // surface leaves open (a sphere's turn) and hardly move what it fixes.
+    double anchor_total = 0;
+    for (const IcpAnchor& anchor : anchors) anchor_total += anchor.weight;
+    const double anchor_scale =
+        anchor_total > 0 ? options.anchor_share * std::max(inliers, 1) / anchor_total : 0.0;
     for (const IcpAnchor& anchor : anchors) {
+      const double weight = anchor.weight * anchor_scale;
       const Eigen::Vector3d p = correction * anchor.current;
       const Eigen::Vector3d residual = p - anchor.target;
       for (int k = 0; k < 3; ++k) {
         Eigen::Matrix<double, 6, 1> row;
-        row << p.cross(Eigen::Vector3d::Unit(k)), Eigen::Vector3d::Unit(k);
-        normal_matrix += anchor.weight * row * row.transpose();
-        rhs -= anchor.weight * row * residual[k];
+        row << ((p - centre) / scale).cross(Eigen::Vector3d::Unit(k)), Eigen::Vector3d::Unit(k);
+        normal_matrix += weight * row * row.transpose();
+        rhs -= weight * row * residual[k];
       }
     }
     if (inliers < 6) break;
-    // A little (Marquardt) damping: directions the surface does not constrain (a sphere's
-    // turn, a cylinder's slide) stay where the prediction put them instead of moving at random.
+    // A little (Marquardt) damping keeps directions the data do not constrain at all where the
+    // prediction put them.
     normal_matrix.diagonal() *= 1.0 + 1e-4;
     normal_matrix.diagonal().array() += 1e-9;
     const Eigen::Matrix<double, 6, 1> step = normal_matrix.ldlt().solve(rhs);
     if (!step.allFinite()) break;
-    correction = Rigid3::FromRotationVector(step.head<3>(), step.tail<3>()) * correction;
+    const Rigid3 turn = Rigid3::FromRotationVector(step.head<3>() / scale, Eigen::Vector3d::Zero());
+    correction = Rigid3::Translation(centre + step.tail<3>()) * turn *
+                 Rigid3::Translation(-centre) * correction;
     result.iterations = iteration + 1;
-    if (step.tail<3>().norm() + 50.0 * step.head<3>().norm() < 0.01) break;
+    if (step.tail<3>().norm() + step.head<3>().norm() < 0.01) break;
   }
   result.inliers = inliers;
   result.rms_mm = rms;

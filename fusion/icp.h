@@ -22,6 +22,10 @@ struct IcpOptions {
   double max_distance_mm = 5.0;
   /// Fewer pairs than this share of the points (or than 50) and the result is not trusted.
   double min_inlier_fraction = 0.2;
+  /// The anchors (contacts) together weigh this share of the surface's point pairs (each in
+  /// proportion to its own weight): enough to hold what the surface leaves free (a sphere's
+  /// turn, a cylinder's turn about its axis), too little to pull against what it fixes.
+  double anchor_share = 0.05;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -41,8 +45,9 @@ struct IcpResult {
 };
 
 /// A point of the current frame (camera frame, mm) that must land at `target`, where the
-/// prediction puts it (e.g. a fingertip contact moved by the pairwise registration), weighted
-/// against one point-to-plane pair. Anchors hold what the surface alone cannot: a sphere's turn.
+/// prediction puts it (e.g. a fingertip contact moved by the pairwise registration), with a
+/// relative weight among the anchors (IcpOptions::anchor_share sets their total). Anchors hold
+/// what the surface alone cannot: a sphere's turn.
 struct IcpAnchor {
   Eigen::Vector3d current;
   Eigen::Vector3d target;

@@ -39,12 +39,46 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(min_object_points >= 10, "fusion.min_object_points must be >= 10");
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
+  IHS_CHECK_ARG(anchor_slip_mm > 0, "fusion.anchor_slip_mm must be positive");
 }
 
 ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
     : intrinsics_(intrinsics),
       options_((options.Check(), std::move(options))),
       volume_(options_.tsdf) {}
+
+int ObjectFusion::ApplyAnchors(const FusionInput& input, PairwiseInput* correspondences) const {
+  if (!options_.anchor_contacts || input.contact_ids.empty()) return 0;
+  int anchored = 0;
+  for (size_t i = 0; i < correspondences->contacts.size(); ++i) {
+    const auto found = anchors_.find(input.contact_ids[i]);
+    if (found == anchors_.end()) continue;
+    correspondences->contacts[i].previous = cam_from_object_ * found->second.object_point;
+    ++anchored;
+  }
+  return anchored;
+}
+
+void ObjectFusion::UpdateAnchors(const FusionInput& input, const Rigid3& cam_from_object) {
+  std::unordered_map<int, Anchor> held;
+  if (options_.anchor_contacts && !input.contact_ids.empty()) {
+    const Rigid3 object_from_cam = cam_from_object.Inverse();
+    for (size_t i = 0; i < input.contact_ids.size(); ++i) {
+      const Eigen::Vector3d seen = object_from_cam * input.correspondences.contacts[i].current;
+      Anchor anchor{seen, 1};
+      const auto found = anchors_.find(input.contact_ids[i]);
+      if (found != anchors_.end() &&
+          (found->second.object_point - seen).norm() <= options_.anchor_slip_mm) {
+        // The running mean of where the contact has been seen.
+        anchor = found->second;
+        ++anchor.observations;
+        anchor.object_point += (seen - anchor.object_point) / anchor.observations;
+      }
+      held[input.contact_ids[i]] = anchor;
+    }
+  }
+  anchors_ = std::move(held);
+}
 
 FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const auto started_at = Clock::now();
@@ -53,6 +87,9 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const Frame& frame = *input.frame;
   const std::vector<std::uint8_t>& mask = *input.object_mask;
   IHS_CHECK_ARG(mask.size() == frame.depth_mm.size(), "the object mask does not fit the frame");
+  IHS_CHECK_ARG(input.contact_ids.empty() ||
+                    input.contact_ids.size() == input.correspondences.contacts.size(),
+                "contact_ids must be empty or one per contact");
   FusionResult result;
   result.cam_from_object = cam_from_object_;
   auto finish = [&](FusionStatus status, std::string reason = {}) {
@@ -97,7 +134,9 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   // The correspondences' motion, then ICP from there.
   Rigid3 pose = cam_from_object_;
   const auto pairwise_start = Clock::now();
-  result.pairwise = RegisterPair(input.correspondences, options_.pairwise);
+  PairwiseInput correspondences = input.correspondences;
+  result.anchored_contacts = ApplyAnchors(input, &correspondences);
+  result.pairwise = RegisterPair(correspondences, options_.pairwise);
   result.pairwise_ms = MillisecondsSince(pairwise_start);
   if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
   if (options_.use_icp) {
@@ -109,7 +148,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     // The contacts, where the registration moved them, hold ICP where the surface cannot.
     std::vector<IcpAnchor> anchors;
     if (result.pairwise.ok && options_.pairwise.contact_weight > 0) {
-      for (const PointMatch& contact : input.correspondences.contacts) {
+      for (const PointMatch& contact : correspondences.contacts) {
         anchors.push_back({contact.current,
                            result.pairwise.current_from_previous * contact.previous,
                            options_.pairwise.contact_weight});
@@ -146,6 +185,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const auto integrate_start = Clock::now();
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
   result.integrate_ms = MillisecondsSince(integrate_start);
+  UpdateAnchors(input, pose);
   return finish(FusionStatus::kFused);
 }
 

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/camera_intrinsics.h"
@@ -32,6 +33,13 @@ struct FusionOptions {
   /// from the previous frame is implausible: the frame is skipped, not integrated.
   double max_jump_mm = 40.0;
   double max_jump_deg = 30.0;
+  /// A fingertip contact held over consecutive frames is anchored at one point of the object
+  /// (the mean of where it was seen, in the object frame) rather than only at where the
+  /// previous frame had it: while a grasp holds, the hand tracker's noise does not add up from
+  /// frame to frame (the paper chains frame pairs and drifts). A contact farther than
+  /// `anchor_slip_mm` from its anchor after registration has slipped and starts anew.
+  bool anchor_contacts = true;
+  double anchor_slip_mm = 4.0;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -45,6 +53,9 @@ struct FusionInput {
   const std::vector<std::uint8_t>* object_mask = nullptr;
   /// Correspondences with the previous frame (camera frame, mm).
   PairwiseInput correspondences;
+  /// For each of `correspondences.contacts`, what identifies the touching skin point from
+  /// frame to frame (the hand model's vertex index); empty: contacts are not anchored.
+  std::vector<int> contact_ids;
 };
 
 /// What happened to a frame.
@@ -67,6 +78,8 @@ struct FusionResult {
   PairwiseResult pairwise;
   IcpResult icp;
   int integrated_voxels = 0;
+  /// Contacts registered against their anchor rather than the previous frame.
+  int anchored_contacts = 0;
   /// Time spent, ms: in all, and on the pairwise solve, the model's raycast, ICP and the
   /// integration.
   double milliseconds = 0;
@@ -90,11 +103,23 @@ class ObjectFusion {
   const FusionOptions& options() const { return options_; }
 
  private:
+  // Replaces the previous-frame positions of anchored contacts by their anchors (seen from the
+  // previous pose); returns how many.
+  int ApplyAnchors(const FusionInput& input, PairwiseInput* correspondences) const;
+  // After registering at `cam_from_object`: anchors of the contacts still held, updated.
+  void UpdateAnchors(const FusionInput& input, const Rigid3& cam_from_object);
+
+  struct Anchor {
+    Eigen::Vector3d object_point;
+    int observations = 0;
+  };
+
   const CameraIntrinsics intrinsics_;
   const FusionOptions options_;
   TsdfVolume volume_;
   bool started_ = false;
   Rigid3 cam_from_object_;
+  std::unordered_map<int, Anchor> anchors_;
 };
 
 }  // namespace ihs::fusion

@@ -46,6 +46,7 @@ double MillisecondsSince(Clock::time_point start) {
 struct Args {
   std::string input, out, gt, object, template_name = "procedural";
   bool init_from_gt = false, no_icp = false, contacts_only = false, no_color = false;
+  bool no_anchors = false;
   double hand_scale = 0, gamma_t = 15.0;
   int hand_dilation_px = 4;
   std::int64_t max_frames = 0;
@@ -74,6 +75,7 @@ int Run(const Args& args) {
   fusion_options.pairwise.contact_weight = args.gamma_t;
   if (args.contacts_only) fusion_options.pairwise.visual_weight = 0;
   fusion_options.use_icp = !args.no_icp;
+  fusion_options.anchor_contacts = !args.no_anchors;
   fusion_options.tsdf.color = !args.no_color;
   fusion::MeshingOptions meshing_options;
   meshing_options.color = !args.no_color;
@@ -148,6 +150,7 @@ int Run(const Args& args) {
     entry["features_ms"] = MillisecondsSince(start);
     for (const auto& pair : tracked.contact_pairs) {
       input.correspondences.contacts.push_back({pair.previous_mm, pair.current_mm});
+      input.contact_ids.push_back(pair.vertex);
     }
     const fusion::FusionResult fused = object_fusion.Fuse(input);
     ++fusion_counts[fusion::ToString(fused.status)];
@@ -159,6 +162,7 @@ int Run(const Args& args) {
     entry["integrate_ms"] = fused.integrate_ms;
     entry["sift_matches"] = input.correspondences.features_2d.size();
     entry["contact_pairs"] = input.correspondences.contacts.size();
+    entry["anchored_contacts"] = fused.anchored_contacts;
     if (fused.status == fusion::FusionStatus::kSkipped) {
       entry["fusion_reason"] = fused.reason;
       // Counted by the reason's kind (the text before any numbers).
@@ -320,6 +324,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1000.0));
   app.add_flag("--contacts-only", args.contacts_only, "no visual features: contacts (and ICP)");
   app.add_flag("--no-icp", args.no_icp, "no ICP against the model");
+  app.add_flag("--no-anchors", args.no_anchors,
+               "contacts registered frame to frame only, as the paper does (no anchors)");
   app.add_flag("--no-color", args.no_color, "meshes without colour");
   app.add_option("--hand-dilation", args.hand_dilation_px,
                  "pixels around the posed hand model kept out of the object")
