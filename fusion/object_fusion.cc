@@ -40,6 +40,8 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
   IHS_CHECK_ARG(anchor_slip_mm > 0, "fusion.anchor_slip_mm must be positive");
+  IHS_CHECK_ARG(icp_retry_fraction >= 0 && icp_retry_fraction <= 1,
+                "fusion.icp_retry_fraction must be in [0, 1]");
 }
 
 ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
@@ -154,12 +156,26 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
                            options_.pairwise.contact_weight});
       }
     }
-    const auto raycast_start = Clock::now();
-    const RaycastImage model = volume_.Raycast(intrinsics_, pose, roi);
-    result.raycast_ms = MillisecondsSince(raycast_start);
-    const auto icp_start = Clock::now();
-    result.icp = AlignToModel(points, model, intrinsics_, pose, options_.icp, anchors);
-    result.icp_ms = MillisecondsSince(icp_start);
+    auto align = [&](const Rigid3& predicted, const std::vector<IcpAnchor>& with) {
+      const auto raycast_start = Clock::now();
+      const RaycastImage model = volume_.Raycast(intrinsics_, predicted, roi);
+      result.raycast_ms += MillisecondsSince(raycast_start);
+      const auto icp_start = Clock::now();
+      IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, options_.icp, with);
+      result.icp_ms += MillisecondsSince(icp_start);
+      return icp;
+    };
+    result.icp = align(pose, anchors);
+    // A registration that lands far off (a bad contact, a slipped finger) leaves ICP few pairs;
+    // from where the object was, it may find more.
+    const double paired = static_cast<double>(result.icp.inliers) / points.size();
+    if (result.pairwise.ok && (!result.icp.ok || paired < options_.icp_retry_fraction)) {
+      IcpResult retry = align(cam_from_object_, {});
+      if (retry.ok && retry.inliers > 1.2 * result.icp.inliers) {
+        result.icp = std::move(retry);
+        result.icp_from_previous = true;
+      }
+    }
     if (result.icp.ok) {
       pose = result.icp.cam_from_volume;
     } else if (!result.pairwise.ok) {

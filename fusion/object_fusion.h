@@ -27,6 +27,9 @@ struct FusionOptions {
   IcpOptions icp;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
+  /// When ICP from the registration's pose pairs fewer than this share of the object's points,
+  /// it is tried again from the previous pose, and that result kept if it pairs 20 % more.
+  double icp_retry_fraction = 0.7;
   /// A frame needs this many object points.
   int min_object_points = 200;
   /// A pose that moves the object's centre farther than this, or turns it by more than this,
@@ -80,6 +83,9 @@ struct FusionResult {
   int integrated_voxels = 0;
   /// Contacts registered against their anchor rather than the previous frame.
   int anchored_contacts = 0;
+  /// Whether ICP started from the previous pose won over the registration's (see
+  /// FusionOptions::icp_retry_fraction).
+  bool icp_from_previous = false;
   /// Time spent, ms: in all, and on the pairwise solve, the model's raycast, ICP and the
   /// integration.
   double milliseconds = 0;

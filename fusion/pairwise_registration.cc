@@ -1,5 +1,6 @@
 #include "fusion/pairwise_registration.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -18,6 +19,7 @@ void PairwiseOptions::Check() const {
   IHS_CHECK_ARG(inlier_mm > 0, "pairwise.inlier_mm must be positive");
   IHS_CHECK_ARG(min_visual_inliers >= 3, "pairwise.min_visual_inliers must be >= 3");
   IHS_CHECK_ARG(min_contacts >= 3, "pairwise.min_contacts must be >= 3");
+  IHS_CHECK_ARG(min_contact_spread_mm >= 0, "pairwise.min_contact_spread_mm must be >= 0");
 }
 
 namespace {
@@ -68,6 +70,23 @@ std::vector<PointMatch> RansacInliers(const std::vector<PointMatch>& matches,
                                                                         : std::vector<PointMatch>{};
 }
 
+// The largest standard deviation of the contacts' previous positions, mm.
+double Spread(const std::vector<PointMatch>& contacts) {
+  if (contacts.size() < 2) return 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const PointMatch& m : contacts) mean += m.previous;
+  mean /= static_cast<double>(contacts.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const PointMatch& m : contacts) {
+    covariance += (m.previous - mean) * (m.previous - mean).transpose();
+  }
+  covariance /= static_cast<double>(contacts.size());
+  return std::sqrt(std::max(
+      0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance, Eigen::EigenvaluesOnly)
+               .eigenvalues()
+               .maxCoeff()));
+}
+
 }  // namespace
 
 PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& options) {
@@ -79,7 +98,9 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     visual.insert(visual.end(), input.features_3d.begin(), input.features_3d.end());
     visual = RansacInliers(visual, options);
   }
-  const bool use_contacts = options.contact_weight > 0 &&
+  const double spread = Spread(input.contacts);
+  result.contact_spread_mm = spread;
+  const bool use_contacts = options.contact_weight > 0 && spread >= options.min_contact_spread_mm &&
                             (static_cast<int>(input.contacts.size()) >= options.min_contacts ||
                              (!visual.empty() && !input.contacts.empty()));
   if (visual.empty() && !use_contacts) {
@@ -87,7 +108,11 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
                     " 2D and " + std::to_string(input.features_3d.size()) +
                     " 3D feature matches (no consistent set of " +
                     std::to_string(options.min_visual_inliers) + "), " +
-                    std::to_string(input.contacts.size()) + " contacts";
+                    std::to_string(input.contacts.size()) + " contacts" +
+                    (input.contacts.empty()
+                         ? ""
+                         : " spread over " + std::to_string(std::lround(spread)) + " mm (need " +
+                               std::to_string(std::lround(options.min_contact_spread_mm)) + ")");
     return result;
   }
   std::vector<Eigen::Vector3d> from, to;

@@ -40,6 +40,10 @@ struct PairwiseOptions {
   int min_visual_inliers = 6;
   /// Contact pairs needed when they are all there is.
   int min_contacts = 3;
+  /// Contacts count only when they spread at least this far (their largest standard deviation
+  /// in the previous frame, mm): one fingertip's patch (the paper asks for two contact bones)
+  /// pins a point of the object, not its turn.
+  double min_contact_spread_mm = 20.0;
   /// Seed of the RANSAC sampling (results are deterministic).
   std::uint32_t seed = 1;
 
@@ -57,6 +61,8 @@ struct PairwiseResult {
   /// Pairs used: visual inliers and contacts.
   int visual_inliers = 0;
   int contacts = 0;
+  /// The contacts' spread (see PairwiseOptions::min_contact_spread_mm), mm.
+  double contact_spread_mm = 0;
   /// Root mean square distance of the used pairs after the solve, mm.
   double rms_mm = 0;
 };
