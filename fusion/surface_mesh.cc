@@ -219,7 +219,7 @@ int FillHoles(TriangleMesh* mesh) {
 }
 
 TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
-                                bool color) {
+                                double scale, bool color) {
   constexpr size_t kMinPoints = 16;
   if (mesh.vertices.size() < kMinPoints) return {};
   TriangleMesh oriented = mesh;
@@ -241,6 +241,7 @@ TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samp
   poisson.setDepth(depth);
   poisson.setSamplesPerNode(static_cast<float>(samples_per_node));
   poisson.setManifold(true);
+  poisson.setScale(static_cast<float>(scale));
   poisson.setOutputPolygons(false);
   poisson.setInputCloud(cloud);
   pcl::PointCloud<pcl::PointNormal> points;
@@ -297,10 +298,10 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options)
   if (options.poisson) {
     start = std::chrono::steady_clock::now();
     // Poisson may close off stray bubbles beside the surface: they go like small pieces do.
-    result.watertight =
-        RemoveSmallComponents(PoissonReconstruct(result.smoothed, options.poisson_depth,
-                                                 options.poisson_samples_per_node, options.color),
-                              options.min_component_fraction);
+    result.watertight = RemoveSmallComponents(
+        PoissonReconstruct(result.smoothed, options.poisson_depth, options.poisson_samples_per_node,
+                           options.poisson_scale, options.color),
+        options.min_component_fraction);
     result.poisson_ms = MillisecondsSince(start);
   }
   return result;

@@ -26,6 +26,10 @@ struct MeshingOptions {
   /// Minimum samples per octree node: larger smooths noisy data (Kazhdan et al.: 1–5 clean,
   /// more for noisy scans).
   double poisson_samples_per_node = 2.0;
+  /// Edge of Poisson's cube over the points' bounding box (PCL's default 1.1): room for the
+  /// implicit surface to close over what was never seen (under the fingers) inside the cube
+  /// rather than running into its faces.
+  double poisson_scale = 1.5;
   /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).
   bool color = true;
 
@@ -47,13 +51,14 @@ void SmoothHcLaplacian(TriangleMesh* mesh, int iterations, double alpha, double 
 int FillHoles(TriangleMesh* mesh);
 
 /// A watertight mesh through the oriented points of `mesh` (its vertices and normals; normals are
-/// computed when missing) by Poisson reconstruction at octree `depth`. Faces are oriented
+/// computed when missing) by Poisson reconstruction at octree `depth`, over a cube `scale` times
+/// the points' bounding box. Faces are oriented
 /// outward; colours come from the nearest input vertex when `color` and the input has them.
 /// PCL's extraction now and then drops a triangle whose edge it cannot match (printing "Vertex
 /// pair not in list" to stdout, which is kept out of ours): the small holes left are filled.
 /// Returns an empty mesh when `mesh` has too few vertices to reconstruct from.
 TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
-                                bool color);
+                                double scale, bool color);
 
 /// The exported meshes of one raw marching-cubes mesh.
 struct MeshingResult {

@@ -111,7 +111,7 @@ TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
     if (below) open.faces.push_back(face);
   }
   ASSERT_FALSE(open.IsWatertight());
-  const TriangleMesh closed = PoissonReconstruct(open, 8, 2.0, false);
+  const TriangleMesh closed = PoissonReconstruct(open, 8, 2.0, 1.5, false);
   ASSERT_GT(closed.faces.size(), 1000u);
   EXPECT_TRUE(closed.IsWatertight());
   EXPECT_GT(closed.Volume(), 0);  // Outward faces.
