@@ -1,0 +1,89 @@
+// Evaluation against ground truth: the true trajectory scores zero, a known error is measured
+// as such, and the true object placed by any consistent trajectory matches itself.
+
+#include "tools/evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/mesh_io.h"
+#include "tests/test_util.h"
+#include "tools/synth/sequence.h"
+
+namespace ihs::eval {
+namespace {
+
+class EvaluationTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir();
+    synth::SequenceOptions options;
+    options.scripted.frames = 60;
+    options.last_frame = 19;
+    options.write_oni = false;
+    options.write_tum = false;
+    synth::GenerateSequence(options, dir_->path() / "seq");
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::filesystem::path Gt() { return dir_->path() / "seq" / "gt"; }
+  static inline test::TempDir* dir_ = nullptr;
+};
+
+TEST_F(EvaluationTest, TheTrueTrajectoryHasNoErrorAndAKnownSlipIsMeasured) {
+  const auto truth = ReadTumTrajectory(Gt() / "trajectory.txt");
+  ASSERT_EQ(truth.size(), 20u);
+  const PairwiseError exact = ContactPairwiseError(Gt(), truth);
+  ASSERT_GT(exact.samples, 20);  // Two or three fingertips on the ball in most frames.
+  EXPECT_LT(exact.mean_mm, 1e-6);
+  EXPECT_LT(CompareTrajectory(Gt(), truth).max_mm, 1e-6);
+
+  // The scan's object frame is anything consistent: the truth's, moved by a fixed offset.
+  std::vector<StampedPose> offset = truth;
+  const Rigid3 scan_from_truth =
+      Rigid3::Translation({5, -3, 40}) * Rigid3::FromAxisAngle({0, 0, 1}, 0.3);
+  for (auto& pose : offset) pose.transform = pose.transform * scan_from_truth.Inverse();
+  EXPECT_LT(ContactPairwiseError(Gt(), offset).mean_mm, 1e-6);
+  EXPECT_LT(CompareTrajectory(Gt(), offset).max_mm, 1e-6);
+
+  // One frame k alone 2 mm off along x in the camera: the pairs k−1 → k and k → k+1 are off by
+  // exactly 2 mm at every fingertip touching in both of their frames, the others not at all.
+  int checked = 0;
+  for (size_t k = 1; k + 1 < truth.size(); ++k) {
+    std::vector<StampedPose> slipped = truth;
+    slipped[k].transform = Rigid3::Translation({2, 0, 0}) * slipped[k].transform;
+    const PairwiseError slip = ContactPairwiseError(Gt(), slipped);
+    EXPECT_EQ(slip.samples, exact.samples);
+    const double touching = slip.mean_mm * slip.samples / 2.0;
+    EXPECT_NEAR(touching, std::round(touching), 1e-6) << "frame " << k;
+    EXPECT_LE(std::round(touching), 10) << "frame " << k;
+    checked += touching > 0.5;
+    EXPECT_NEAR(CompareTrajectory(Gt(), slipped).max_mm, 2.0, 1e-6);
+    EXPECT_NEAR(CompareTrajectory(Gt(), slipped).mean_mm, 2.0 / slipped.size(), 1e-6);
+  }
+  EXPECT_GT(checked, 5);
+}
+
+TEST_F(EvaluationTest, TheTrueObjectMatchesItselfPlacedByTheTrajectory) {
+  const auto truth = ReadTumTrajectory(Gt() / "trajectory.txt");
+  const TriangleMesh object = ReadMesh(Gt() / "object.ply");
+  // The "scan" in an object frame of its own, and the trajectory that goes with it.
+  const Rigid3 scan_from_truth = Rigid3::Translation({-20, 8, 3});
+  TriangleMesh scan = object;
+  for (auto& v : scan.vertices)
+    v = (scan_from_truth * Eigen::Vector3d(v.cast<double>())).cast<float>();
+  std::vector<StampedPose> trajectory = truth;
+  for (auto& pose : trajectory) pose.transform = pose.transform * scan_from_truth.Inverse();
+  const fusion::SurfaceComparison same = CompareWithTruth(Gt(), scan, trajectory);
+  EXPECT_LT(same.chamfer_mm, 0.2);
+  EXPECT_GT(same.completeness, 0.999);
+  // Dimensions of the true sphere.
+  const auto rows = PaperDimensions("sphere", object);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_NEAR(rows[0].truth_mm, 70.0, 0.1);
+  EXPECT_NEAR(TrueVolume("sphere") / (4.0 / 3.0 * M_PI * 35 * 35 * 35), 1.0, 0.002);
+  EXPECT_THROW(PaperDimensions("teapot", object), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ihs::eval
