@@ -142,9 +142,10 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   result.pairwise_ms = MillisecondsSince(pairwise_start);
   if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
   if (options_.use_icp) {
-    // The model where the object was, grown by the largest plausible jump.
-    const int margin = static_cast<int>(
-        std::ceil(options_.max_jump_mm * intrinsics_.fx / std::max(1.0, pose.translation().z())));
+    // The model where the object's points are, grown by what ICP can still pair them over
+    // (a point moves by less than that between ICP's start and its end).
+    const int margin = static_cast<int>(std::ceil(
+        2 * options_.icp.max_distance_mm * intrinsics_.fx / std::max(1.0, pose.translation().z())));
     const std::array<int, 4> roi = {box[0] - margin, box[1] - margin, box[2] + margin,
                                     box[3] + margin};
     // The contacts, where the registration moved them, hold ICP where the surface cannot.
@@ -156,9 +157,19 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
                            options_.pairwise.contact_weight});
       }
     }
+    // The model is needed only near the object's points: rays start a little in front of them.
+    std::vector<std::uint16_t> near(frame.depth_mm.size(), 0);
+    for (int v = std::max(0, box[1]); v < box[3]; ++v) {
+      for (int u = std::max(0, box[0]); u < box[2]; ++u) {
+        const int pixel = v * frame.width + u;
+        if (mask[pixel]) near[pixel] = frame.depth_mm[pixel];
+      }
+    }
+    const float window =
+        static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
     auto align = [&](const Rigid3& predicted, const std::vector<IcpAnchor>& with) {
       const auto raycast_start = Clock::now();
-      const RaycastImage model = volume_.Raycast(intrinsics_, predicted, roi);
+      const RaycastImage model = volume_.Raycast(intrinsics_, predicted, roi, &near, window);
       result.raycast_ms += MillisecondsSince(raycast_start);
       const auto icp_start = Clock::now();
       IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, options_.icp, with);

@@ -40,7 +40,8 @@ TsdfVolume::TsdfVolume(TsdfOptions options)
       observed_lo_{n_, n_, n_},
       voxel_mm_(options_.size_mm / options_.resolution),
       truncation_mm_(options_.truncation_voxels * voxel_mm_),
-      voxels_(static_cast<size_t>(n_) * n_ * n_) {}
+      voxels_(static_cast<size_t>(n_) * n_ * n_),
+      touched_bits_((voxels_.size() + 63) / 64, 0) {}
 
 Eigen::Vector3f TsdfVolume::Centre(int i, int j, int k) const {
   const double half = 0.5 * options_.size_mm;
@@ -84,12 +85,17 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
         const int j = static_cast<int>(std::floor(grid.y() / voxel));
         const int k = static_cast<int>(std::floor(grid.z() / voxel));
         if (i < 0 || j < 0 || k < 0 || i >= n_ || j >= n_ || k >= n_) continue;
-        touched.push_back(Index(i, j, k));
+        const std::int64_t index = Index(i, j, k);
+        // Each voxel once: a bit per voxel, set here and cleared again below.
+        std::uint64_t& word = touched_bits_[index >> 6];
+        const std::uint64_t bit = std::uint64_t{1} << (index & 63);
+        if (word & bit) continue;
+        word |= bit;
+        touched.push_back(index);
       }
     }
   }
-  std::sort(touched.begin(), touched.end());
-  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  for (const std::int64_t index : touched) touched_bits_[index >> 6] = 0;
 
   // Projective update of each: the distance along the ray from the voxel to the surface seen
   // through its pixel.
@@ -158,7 +164,9 @@ bool TsdfVolume::SignedDistance(const Eigen::Vector3f& point, float* distance_mm
 }
 
 RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume,
-                                 const std::array<int, 4>& roi) const {
+                                 const std::array<int, 4>& roi,
+                                 const std::vector<std::uint16_t>* near_depth_mm,
+                                 float window_mm) const {
   RaycastImage image;
   image.width = intrinsics.width;
   image.height = intrinsics.height;
@@ -179,16 +187,25 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
     box_lo[a] = -half + observed_lo_[a] * voxel;
     box_hi[a] = -half + (observed_hi_[a] + 1) * voxel;
   }
+  IHS_CHECK_ARG(near_depth_mm == nullptr || near_depth_mm->size() == pixels,
+                "near_depth_mm has " << near_depth_mm->size() << " entries, the image " << pixels);
   const bool whole = roi[2] <= roi[0] || roi[3] <= roi[1];
   const int u0 = whole ? 0 : std::max(0, roi[0]), v0 = whole ? 0 : std::max(0, roi[1]);
   const int u1 = whole ? image.width : std::min(image.width, roi[2]);
   const int v1 = whole ? image.height : std::min(image.height, roi[3]);
   for (int v = v0; v < v1; ++v) {
     for (int u = u0; u < u1; ++u) {
+      const std::uint16_t near = near_depth_mm ? (*near_depth_mm)[v * image.width + u] : 0;
+      if (near_depth_mm && near == 0) continue;
       const Eigen::Vector3f ray_cam = intrinsics.BackProject(u, v, 1.0).cast<float>();
       const Eigen::Vector3f ray = rotation * ray_cam.normalized();
-      // Where the ray is inside the cube (slabs).
+      // Where the ray is inside the observed box (slabs), and the window.
       float t_near = 0, t_far = std::numeric_limits<float>::infinity();
+      if (near_depth_mm) {
+        const float length = ray_cam.norm();  // Along the ray per mm of depth.
+        t_near = std::max(0.0f, (near - window_mm) * length);
+        t_far = (near + window_mm) * length;
+      }
       for (int a = 0; a < 3; ++a) {
         if (std::abs(ray[a]) < 1e-9f) {
           if (origin[a] < box_lo[a] || origin[a] > box_hi[a]) t_far = -1;

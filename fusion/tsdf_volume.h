@@ -59,9 +59,13 @@ class TsdfVolume {
                 const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume);
 
   /// The model's surface seen from `cam_from_volume`: the first zero crossing along each ray.
-  /// Only the pixels in `roi` (u0, v0, u1, v1, exclusive ends; all when empty) are cast.
+  /// Only the pixels in `roi` (u0, v0, u1, v1, exclusive ends; all when empty) are cast. With
+  /// `near_depth_mm` (per pixel, row-major), a ray is cast only where it is non-zero and only
+  /// within `window_mm` of that depth: for ICP, the model near the observed points is enough.
   RaycastImage Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume,
-                       const std::array<int, 4>& roi = {0, 0, 0, 0}) const;
+                       const std::array<int, 4>& roi = {0, 0, 0, 0},
+                       const std::vector<std::uint16_t>* near_depth_mm = nullptr,
+                       float window_mm = 0) const;
 
   /// The zero level set by marching cubes (volume frame, mm), over cells whose eight corners
   /// have all been observed; with per-vertex colour when kept. Vertices are shared between
@@ -99,6 +103,8 @@ class TsdfVolume {
   const double voxel_mm_;
   const double truncation_mm_;
   std::vector<Voxel> voxels_;
+  // Scratch for Integrate: one bit per voxel, all zero between calls.
+  std::vector<std::uint64_t> touched_bits_;
 };
 
 }  // namespace ihs::fusion
