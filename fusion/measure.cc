@@ -101,32 +101,42 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
     if (twice_area <= 0 || std::abs(cross.dot(result.axis)) >= 0.7 * twice_area) continue;
     for (int c = 0; c < 3; ++c) vertex_weight[f[c]] += twice_area / 6;
   }
+  // Per bin, a weighted least-squares circle (Kåsa's algebraic fit) through the vertices
+  // projected onto the plane across the axis: right also where a scan saw only part of a
+  // section's circle, where the vertices' centroid would be pulled toward the part seen.
+  const Eigen::Vector3d across_u = result.axis.unitOrthogonal();
+  const Eigen::Vector3d across_v = result.axis.cross(across_u);
   std::vector<double> weight(bins, 0.0), radius(bins, 0.0);
-  std::vector<Eigen::Vector3d> bin_centre(bins, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> normal(bins, Eigen::Matrix3d::Zero());
+  std::vector<Eigen::Vector3d> rhs(bins, Eigen::Vector3d::Zero());
   auto bin_of = [&](const Eigen::Vector3d& p) {
     const double h = (p - centre).dot(result.axis) - low;
     return std::clamp(static_cast<int>(h / slice_mm), 0, bins - 1);
   };
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-    if (vertex_weight[i] <= 0) continue;
+    const double w = vertex_weight[i];
+    if (w <= 0) continue;
     const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
     const int b = bin_of(p);
-    weight[b] += vertex_weight[i];
-    bin_centre[b] += vertex_weight[i] * p;
+    const double x = (p - centre).dot(across_u), y = (p - centre).dot(across_v);
+    const Eigen::Vector3d row(x, y, 1.0);
+    weight[b] += w;
+    normal[b] += w * row * row.transpose();
+    rhs[b] -= w * (x * x + y * y) * row;
   }
-  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-    if (vertex_weight[i] <= 0) continue;
-    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
-    const int b = bin_of(p);
-    const Eigen::Vector3d d = p - bin_centre[b] / weight[b];
-    radius[b] += vertex_weight[i] * (d - d.dot(result.axis) * result.axis).norm();
+  for (int b = 0; b < bins; ++b) {
+    if (weight[b] <= 0) continue;
+    // x² + y² + D·x + E·y + F = 0: centre (−D/2, −E/2), r² = (D² + E²)/4 − F.
+    const Eigen::Vector3d def = normal[b].ldlt().solve(rhs[b]);
+    const double r_sq = 0.25 * (def[0] * def[0] + def[1] * def[1]) - def[2];
+    radius[b] = def.allFinite() && r_sq > 0 ? std::sqrt(r_sq) * weight[b] : 0.0;
   }
   // Bins with little surface (an end, a gap) are noise: they need a tenth of the typical bin's.
   std::vector<double> sorted = weight;
   std::sort(sorted.begin(), sorted.end());
   const double min_weight = 0.1 * sorted[sorted.size() / 2];
   for (int b = 0; b < bins; ++b) {
-    if (weight[b] <= 0 || weight[b] < min_weight) continue;
+    if (weight[b] <= 0 || weight[b] < min_weight || radius[b] <= 0) continue;
     result.profile.push_back({(b + 0.5) * slice_mm, 2 * radius[b] / weight[b]});
   }
   if (result.profile.empty()) return result;

@@ -32,9 +32,9 @@ struct RevolutionMeasures {
 
 /// Measures `mesh` as a body of revolution. The axis is the principal axis whose spread differs
 /// most from the other two (the long axis of a bottle, the short one of a flat disc; any for a
-/// sphere). Each section's diameter is twice the mean distance of its vertices (weighted by the
-/// area of their side faces; faces turned along the axis, such as flat caps, do not count) from
-/// the section's centre.
+/// sphere). Each section's diameter is that of the least-squares circle through its vertices
+/// (weighted by the area of their side faces; faces turned along the axis, such as flat caps,
+/// do not count), so that a section seen only in part still measures right.
 /// Throws std::invalid_argument for an empty mesh or a non-positive `slice_mm`.
 RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm = 2.0);
 

@@ -257,7 +257,10 @@ int Run(const Args& args) {
 
   if (!args.gt.empty()) {
     nlohmann::json evaluation;
-    const ihs::TriangleMesh& scan = meshes.watertight.Empty() ? meshes.smoothed : meshes.watertight;
+    // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's
+    // closing of what was never seen (a base under the hand) is guesswork that would add to a
+    // bottle's height. The volume needs the watertight mesh.
+    const ihs::TriangleMesh& scan = meshes.smoothed;
     if (!object.empty() && object != "box") {
       const auto rows = ihs::eval::PaperDimensions(object, scan);
       std::printf("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");

@@ -47,6 +47,23 @@ TEST(MeasureTest, ThePaperObjectsMeasureToTheirDimensions) {
   EXPECT_THROW(MeasureRevolution(TriangleMesh{}), std::invalid_argument);
 }
 
+TEST(MeasureTest, APartlySeenObjectStillMeasuresToItsDimensions) {
+  // A third of the bottle's surface never seen (a scan's blind side): its sections are arcs.
+  const TriangleMesh whole = synth::MakeLatheMesh(
+      synth::ResampleProfile(synth::PaperObjectProfile("water-bottle"), 0.5), 256);
+  TriangleMesh seen = whole;
+  seen.faces.clear();
+  for (const auto& f : whole.faces) {
+    const Eigen::Vector3f c =
+        (whole.vertices[f[0]] + whole.vertices[f[1]] + whole.vertices[f[2]]) / 3;
+    if (std::atan2(c.y(), c.x()) < M_PI / 3) seen.faces.push_back(f);
+  }
+  const RevolutionMeasures m = MeasureRevolution(seen);
+  EXPECT_NEAR(m.widest_diameter_mm, 73, 0.5);
+  // The principal axis of two thirds of the surface tilts a little: measured 218.83 mm.
+  EXPECT_NEAR(m.height_mm, 218, 1.0);
+}
+
 TEST(MeasureTest, SurfaceComparisonMeasuresTheGapAndTheCoverage) {
   const TriangleMesh truth = test::MakeUvSphere(35, 64, 128);
   const SurfaceComparison same = CompareSurfaces(truth, truth);
