@@ -25,6 +25,7 @@
 #include "core/trajectory_io.h"
 #include "fusion/object_fusion.h"
 #include "fusion/object_mask.h"
+#include "fusion/shot_matcher.h"
 #include "fusion/sift_matcher.h"
 #include "fusion/surface_mesh.h"
 #include "sensor/open_input.h"
@@ -46,7 +47,7 @@ double MillisecondsSince(Clock::time_point start) {
 struct Args {
   std::string input, out, gt, object, template_name = "procedural";
   bool init_from_gt = false, no_icp = false, contacts_only = false, no_color = false;
-  bool no_anchors = false;
+  bool no_anchors = false, features_3d = false;
   double hand_scale = 0, gamma_t = 15.0;
   int hand_dilation_px = 4;
   std::int64_t max_frames = 0;
@@ -100,6 +101,7 @@ int Run(const Args& args) {
   const ihs::CameraIntrinsics intrinsics = source->Intrinsics();
   tracker::HandTracker hand_tracker(model, intrinsics, tracker_options);
   fusion::SiftMatcher sift(intrinsics);
+  fusion::ShotMatcher shot(intrinsics);
   fusion::ObjectFusion object_fusion(intrinsics, fusion_options);
   const fs::path out = args.out;
   std::error_code error;
@@ -146,7 +148,10 @@ int Run(const Args& args) {
     input.frame = &frame;
     input.object_mask = &mask;
     start = Clock::now();
-    if (!args.contacts_only) input.correspondences.features_2d = sift.Match(frame, mask);
+    if (!args.contacts_only) {
+      input.correspondences.features_2d = sift.Match(frame, mask);
+      if (args.features_3d) input.correspondences.features_3d = shot.Match(frame, mask);
+    }
     entry["features_ms"] = MillisecondsSince(start);
     for (const auto& pair : tracked.contact_pairs) {
       input.correspondences.contacts.push_back({pair.previous_mm, pair.current_mm});
@@ -161,6 +166,7 @@ int Run(const Args& args) {
     entry["icp_ms"] = fused.icp_ms;
     entry["integrate_ms"] = fused.integrate_ms;
     entry["sift_matches"] = input.correspondences.features_2d.size();
+    entry["shot_matches"] = input.correspondences.features_3d.size();
     entry["contact_pairs"] = input.correspondences.contacts.size();
     entry["anchored_contacts"] = fused.anchored_contacts;
     entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;
@@ -340,6 +346,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1000.0));
   app.add_flag("--contacts-only", args.contacts_only, "no visual features: contacts (and ICP)");
   app.add_flag("--no-icp", args.no_icp, "no ICP against the model");
+  app.add_flag("--3d-features", args.features_3d,
+               "add ISS3D + CSHOT matches (the paper's E_feat3d; off by default: about 200 ms per "
+               "frame, and on symmetric objects their matches mislead more than they help)");
   app.add_flag("--no-anchors", args.no_anchors,
                "contacts registered frame to frame only, as the paper does (no anchors)");
   app.add_flag("--no-color", args.no_color, "meshes without colour");
