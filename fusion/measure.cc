@@ -55,30 +55,15 @@ double Mean(const std::vector<double>& values) {
 
 }  // namespace
 
-RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) {
-  IHS_CHECK_ARG(slice_mm > 0, "slice_mm must be positive, got " << slice_mm);
-  const std::vector<Face> faces = Faces(mesh);
-  IHS_CHECK_ARG(!faces.empty(), "cannot measure an empty mesh");
+// The measures of `mesh` taken along `axis` through `centre`; `residual` gets how far the side
+// vertices are from their sections' circles (weighted RMS over the mean radius): small when the
+// axis is a symmetry axis.
+static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Vector3d& centre,
+                                       const Eigen::Vector3d& axis, double slice_mm,
+                                       double* residual) {
   RevolutionMeasures result;
-
-  // Principal axes of the surface.
-  double total_area = 0;
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const Face& f : faces) centre += f.area * f.centroid, total_area += f.area;
-  centre /= total_area;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const Face& f : faces) {
-    const Eigen::Vector3d d = f.centroid - centre;
-    covariance += f.area * d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / total_area);
-  const Eigen::Vector3d spread = solver.eigenvalues();  // Ascending.
-  // The axis: the eigenvalue farthest from the other two (in relative terms).
-  const double gap_low = (spread[1] - spread[0]) / std::max(spread[1], 1e-12);
-  const double gap_high = (spread[2] - spread[1]) / std::max(spread[2], 1e-12);
-  result.axis = solver.eigenvectors().col(gap_high >= gap_low ? 2 : 0).normalized();
+  result.axis = axis;
   result.centre = centre;
-
   // Extent along the axis.
   double low = INFINITY, high = -INFINITY;
   for (const auto& v : mesh.vertices) {
@@ -131,6 +116,24 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
     const double r_sq = 0.25 * (def[0] * def[0] + def[1] * def[1]) - def[2];
     radius[b] = def.allFinite() && r_sq > 0 ? std::sqrt(r_sq) * weight[b] : 0.0;
   }
+  // How well the circles explain the vertices.
+  double misfit = 0, radius_sum = 0, weight_sum = 0;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const double w = vertex_weight[i];
+    if (w <= 0) continue;
+    const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
+    const int b = bin_of(p);
+    if (radius[b] <= 0) continue;
+    const Eigen::Vector3d def = normal[b].ldlt().solve(rhs[b]);
+    const double x = (p - centre).dot(across_u) + 0.5 * def[0];
+    const double y = (p - centre).dot(across_v) + 0.5 * def[1];
+    const double r = radius[b] / weight[b];
+    misfit += w * (std::hypot(x, y) - r) * (std::hypot(x, y) - r);
+    radius_sum += w * r, weight_sum += w;
+  }
+  *residual = weight_sum > 0 && radius_sum > 0
+                  ? std::sqrt(misfit / weight_sum) / (radius_sum / weight_sum)
+                  : INFINITY;
   // Bins with little surface (an end, a gap) are noise: they need a tenth of the typical bin's.
   std::vector<double> sorted = weight;
   std::sort(sorted.begin(), sorted.end());
@@ -160,6 +163,36 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
     if (neck <= 0.8 * result.widest_diameter_mm && d > 1.05 * neck) {
       result.head_diameter_mm = std::max(result.head_diameter_mm, d);
     }
+  }
+  return result;
+}
+
+RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) {
+  IHS_CHECK_ARG(slice_mm > 0, "slice_mm must be positive, got " << slice_mm);
+  const std::vector<Face> faces = Faces(mesh);
+  IHS_CHECK_ARG(!faces.empty(), "cannot measure an empty mesh");
+  RevolutionMeasures result;
+
+  // Principal axes of the surface.
+  double total_area = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Face& f : faces) centre += f.area * f.centroid, total_area += f.area;
+  centre /= total_area;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Face& f : faces) {
+    const Eigen::Vector3d d = f.centroid - centre;
+    covariance += f.area * d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / total_area);
+  // The axis: of the three principal axes, the one about which the surface is most nearly a
+  // body of revolution (its sections fit circles best). The spread alone misleads on squat
+  // objects seen in part.
+  double best = INFINITY;
+  for (int k = 0; k < 3; ++k) {
+    double residual = INFINITY;
+    RevolutionMeasures candidate =
+        MeasureAlong(mesh, centre, solver.eigenvectors().col(k).normalized(), slice_mm, &residual);
+    if (residual < best) best = residual, result = std::move(candidate);
   }
   return result;
 }
