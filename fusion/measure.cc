@@ -12,10 +12,9 @@
 namespace ihs::fusion {
 namespace {
 
-// Area-weighted face centroids and unit normals of a mesh.
+// A mesh's faces as centroids with their areas.
 struct Face {
   Eigen::Vector3d centroid;
-  Eigen::Vector3d normal;
   double area;
 };
 
@@ -29,7 +28,7 @@ std::vector<Face> Faces(const TriangleMesh& mesh) {
     const Eigen::Vector3d cross = (b - a).cross(c - a);
     const double twice_area = cross.norm();
     if (twice_area <= 0) continue;
-    faces.push_back({(a + b + c) / 3, cross / twice_area, 0.5 * twice_area});
+    faces.push_back({(a + b + c) / 3, 0.5 * twice_area});
   }
   return faces;
 }
@@ -92,6 +91,7 @@ static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Ve
   const Eigen::Vector3d across_u = result.axis.unitOrthogonal();
   const Eigen::Vector3d across_v = result.axis.cross(across_u);
   std::vector<double> weight(bins, 0.0), radius(bins, 0.0);
+  std::vector<Eigen::Vector2d> circle_centre(bins, Eigen::Vector2d::Zero());
   std::vector<Eigen::Matrix3d> normal(bins, Eigen::Matrix3d::Zero());
   std::vector<Eigen::Vector3d> rhs(bins, Eigen::Vector3d::Zero());
   auto bin_of = [&](const Eigen::Vector3d& p) {
@@ -114,7 +114,9 @@ static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Ve
     // x² + y² + D·x + E·y + F = 0: centre (−D/2, −E/2), r² = (D² + E²)/4 − F.
     const Eigen::Vector3d def = normal[b].ldlt().solve(rhs[b]);
     const double r_sq = 0.25 * (def[0] * def[0] + def[1] * def[1]) - def[2];
-    radius[b] = def.allFinite() && r_sq > 0 ? std::sqrt(r_sq) * weight[b] : 0.0;
+    if (!def.allFinite() || r_sq <= 0) continue;
+    radius[b] = std::sqrt(r_sq);
+    circle_centre[b] = -0.5 * def.head<2>();
   }
   // How well the circles explain the vertices.
   double misfit = 0, radius_sum = 0, weight_sum = 0;
@@ -124,12 +126,10 @@ static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Ve
     const Eigen::Vector3d p = mesh.vertices[i].cast<double>();
     const int b = bin_of(p);
     if (radius[b] <= 0) continue;
-    const Eigen::Vector3d def = normal[b].ldlt().solve(rhs[b]);
-    const double x = (p - centre).dot(across_u) + 0.5 * def[0];
-    const double y = (p - centre).dot(across_v) + 0.5 * def[1];
-    const double r = radius[b] / weight[b];
-    misfit += w * (std::hypot(x, y) - r) * (std::hypot(x, y) - r);
-    radius_sum += w * r, weight_sum += w;
+    const Eigen::Vector2d d((p - centre).dot(across_u), (p - centre).dot(across_v));
+    const double off = (d - circle_centre[b]).norm() - radius[b];
+    misfit += w * off * off;
+    radius_sum += w * radius[b], weight_sum += w;
   }
   *residual = weight_sum > 0 && radius_sum > 0
                   ? std::sqrt(misfit / weight_sum) / (radius_sum / weight_sum)
@@ -140,7 +140,7 @@ static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Ve
   const double min_weight = 0.1 * sorted[sorted.size() / 2];
   for (int b = 0; b < bins; ++b) {
     if (weight[b] <= 0 || weight[b] < min_weight || radius[b] <= 0) continue;
-    result.profile.push_back({(b + 0.5) * slice_mm, 2 * radius[b] / weight[b]});
+    result.profile.push_back({(b + 0.5) * slice_mm, 2 * radius[b]});
   }
   if (result.profile.empty()) return result;
 

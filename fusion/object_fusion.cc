@@ -3,22 +3,13 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
 #include "core/check.h"
+#include "core/stopwatch.h"
 
 namespace ihs::fusion {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-}  // namespace
 
 const char* ToString(FusionStatus status) {
   switch (status) {
@@ -83,7 +74,7 @@ void ObjectFusion::UpdateAnchors(const FusionInput& input, const Rigid3& cam_fro
 }
 
 FusionResult ObjectFusion::Fuse(const FusionInput& input) {
-  const auto started_at = Clock::now();
+  const auto started_at = SteadyClock::now();
   IHS_CHECK_ARG(input.frame != nullptr && input.object_mask != nullptr,
                 "Fuse needs a frame and its object mask");
   const Frame& frame = *input.frame;
@@ -126,7 +117,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     centre /= static_cast<double>(points.size());
     cam_from_object_ = Rigid3::Translation(centre);
     result.cam_from_object = cam_from_object_;
-    const auto integrate_start = Clock::now();
+    const auto integrate_start = SteadyClock::now();
     result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, cam_from_object_);
     result.integrate_ms = MillisecondsSince(integrate_start);
     started_ = true;
@@ -135,7 +126,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
 
   // The correspondences' motion, then ICP from there.
   Rigid3 pose = cam_from_object_;
-  const auto pairwise_start = Clock::now();
+  const auto pairwise_start = SteadyClock::now();
   PairwiseInput correspondences = input.correspondences;
   result.anchored_contacts = ApplyAnchors(input, &correspondences);
   result.pairwise = RegisterPair(correspondences, options_.pairwise);
@@ -168,10 +159,10 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     const float window =
         static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
     auto align = [&](const Rigid3& predicted, const std::vector<IcpAnchor>& with) {
-      const auto raycast_start = Clock::now();
+      const auto raycast_start = SteadyClock::now();
       const RaycastImage model = volume_.Raycast(intrinsics_, predicted, roi, &near, window);
       result.raycast_ms += MillisecondsSince(raycast_start);
-      const auto icp_start = Clock::now();
+      const auto icp_start = SteadyClock::now();
       IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, options_.icp, with);
       result.icp_ms += MillisecondsSince(icp_start);
       return icp;
@@ -209,7 +200,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   }
   cam_from_object_ = pose;
   result.cam_from_object = pose;
-  const auto integrate_start = Clock::now();
+  const auto integrate_start = SteadyClock::now();
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
   result.integrate_ms = MillisecondsSince(integrate_start);
   UpdateAnchors(input, pose);

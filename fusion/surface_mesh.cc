@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -17,14 +16,10 @@
 
 #include "core/check.h"
 #include "core/point_kd_tree.h"
+#include "core/stopwatch.h"
 
 namespace ihs::fusion {
 namespace {
-
-double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 int Root(std::vector<int>& parent, int i) {
   while (parent[i] != i) {
@@ -286,17 +281,17 @@ TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samp
 MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options) {
   options.Check();
   MeshingResult result;
-  auto start = std::chrono::steady_clock::now();
+  auto start = SteadyClock::now();
   result.smoothed = RemoveSmallComponents(raw, options.min_component_fraction);
   if (!options.color) result.smoothed.colors.clear();
   result.cleanup_ms = MillisecondsSince(start);
-  start = std::chrono::steady_clock::now();
+  start = SteadyClock::now();
   SmoothHcLaplacian(&result.smoothed, options.smoothing_iterations, options.smoothing_alpha,
                     options.smoothing_beta);
   if (!result.smoothed.HasNormals()) result.smoothed.ComputeVertexNormals();
   result.smoothing_ms = MillisecondsSince(start);
   if (options.poisson) {
-    start = std::chrono::steady_clock::now();
+    start = SteadyClock::now();
     // Poisson may close off stray bubbles beside the surface: they go like small pieces do.
     result.watertight = RemoveSmallComponents(
         PoissonReconstruct(result.smoothed, options.poisson_depth, options.poisson_samples_per_node,

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "core/data_lines.h"
@@ -211,6 +213,56 @@ fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const Triangl
   for (auto& v : placed.vertices)
     v = (truth_from_scan * Eigen::Vector3d(v.cast<double>())).cast<float>();
   return fusion::CompareSurfaces(placed, ReadMesh(gt_dir / "object.ply"));
+}
+
+nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
+                          const TriangleMesh& watertight, const fs::path& gt_dir,
+                          const std::vector<StampedPose>& trajectory) {
+  nlohmann::json report = nlohmann::json::object();
+  if (!object.empty()) {
+    const std::vector<DimensionRow> rows = PaperDimensions(object, seen);
+    std::printf("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
+    double sum = 0;
+    for (const DimensionRow& row : rows) {
+      std::printf("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm,
+                  row.captured_mm, row.Error());
+      report["dimensions"].push_back(
+          {{"measure", row.measure}, {"truth_mm", row.truth_mm}, {"scan_mm", row.captured_mm}});
+      sum += std::abs(row.Error());
+    }
+    report["dimension_error_mm_mean"] = sum / rows.size();
+    std::printf("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
+    if (watertight.IsWatertight()) {
+      const double truth = TrueVolume(object), volume = watertight.Volume();
+      std::printf("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%\n", truth, volume,
+                  100 * (volume / truth - 1));
+      report["volume_mm3"] = {{"truth", truth}, {"scan", volume}};
+      report["volume_error"] = volume / truth - 1;
+    }
+  }
+  if (!gt_dir.empty()) {
+    const PairwiseError pairwise = ContactPairwiseError(gt_dir, trajectory);
+    std::printf("pairwise registration error at the fingertips: %.2f ± %.2f mm (median %.2f, %d)\n",
+                pairwise.mean_mm, pairwise.std_mm, pairwise.median_mm, pairwise.samples);
+    report["pairwise_error_mm"] = {{"mean", pairwise.mean_mm},
+                                   {"std", pairwise.std_mm},
+                                   {"median", pairwise.median_mm},
+                                   {"samples", pairwise.samples}};
+    const TrajectoryError drift = CompareTrajectory(gt_dir, trajectory);
+    std::printf("object trajectory error: %.2f mm mean, %.2f mm max, %.2f mm at the end\n",
+                drift.mean_mm, drift.max_mm, drift.final_mm);
+    report["trajectory_error_mm"] = {
+        {"mean", drift.mean_mm}, {"max", drift.max_mm}, {"final", drift.final_mm}};
+    const fusion::SurfaceComparison surface = CompareWithTruth(gt_dir, seen, trajectory);
+    std::printf(
+        "surface: Chamfer %.2f mm (scan→truth %.2f, truth→scan %.2f), completeness %.1f %% "
+        "(within %.1f mm)\n",
+        surface.chamfer_mm, surface.scan_to_truth_mm, surface.truth_to_scan_mm,
+        100 * surface.completeness, surface.within_mm);
+    report["chamfer_mm"] = surface.chamfer_mm;
+    report["completeness"] = surface.completeness;
+  }
+  return report;
 }
 
 }  // namespace ihs::eval

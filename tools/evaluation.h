@@ -5,6 +5,7 @@
 // Shared by inhandscan-scan, inhandscan-measure and the benchmark.
 
 #include <filesystem>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,16 @@ struct TrajectoryError {
 };
 TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
                                   const std::vector<StampedPose>& trajectory);
+
+/// Prints a scan's measures as a table for people on stdout and returns them as JSON: with
+/// `object` (a paper object or lathe:FILE) the paper's dimensions measured on `seen` ("dimensions",
+/// "dimension_error_mm_mean") and, when `watertight` is, its volume against the truth
+/// ("volume_mm3", "volume_error"); with `gt_dir` the pairwise registration error at the
+/// fingertips, the trajectory's drift and `seen` against the true surface ("pairwise_error_mm",
+/// "trajectory_error_mm", "chamfer_mm", "completeness"), `seen` placed by `trajectory`.
+nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
+                          const TriangleMesh& watertight, const std::filesystem::path& gt_dir,
+                          const std::vector<StampedPose>& trajectory);
 
 /// The pose of `trajectory` stamped `time_s` (within half a millisecond), or nullptr.
 const StampedPose* FindPose(const std::vector<StampedPose>& trajectory, double time_s);

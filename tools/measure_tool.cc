@@ -45,48 +45,17 @@ int Run(const std::string& mesh_path, const std::string& object, const std::stri
   if (measures.head_diameter_mm > 0) std::printf("; head Ø%.2f mm", measures.head_diameter_mm);
   std::printf("\n");
   if (mesh.IsWatertight()) {
-    out["volume_mm3"] = mesh.Volume();
+    out["mesh_volume_mm3"] = mesh.Volume();
     std::printf("volume: %.0f mm³\n", mesh.Volume());
   }
-  if (!object.empty()) {
-    std::printf("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
-    double sum = 0;
-    const auto rows = ihs::eval::PaperDimensions(object, mesh);
-    for (const auto& row : rows) {
-      std::printf("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm,
-                  row.captured_mm, row.Error());
-      out["dimensions"].push_back(
-          {{"measure", row.measure}, {"truth_mm", row.truth_mm}, {"scan_mm", row.captured_mm}});
-      sum += std::abs(row.Error());
-    }
-    out["dimension_error_mm_mean"] = sum / rows.size();
-    std::printf("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
-    if (mesh.IsWatertight()) {
-      const double truth = ihs::eval::TrueVolume(object);
-      out["volume_error"] = mesh.Volume() / truth - 1;
-      std::printf("volume: truth %.0f mm³, %+.2f %%\n", truth, 100 * (mesh.Volume() / truth - 1));
-    }
-  }
+  std::vector<ihs::StampedPose> trajectory;
   if (!gt.empty()) {
     if (trajectory_path.empty()) {
       trajectory_path = (fs::path(mesh_path).parent_path() / "trajectory.txt").string();
     }
-    const auto trajectory = ihs::ReadTumTrajectory(trajectory_path);
-    const auto pairwise = ihs::eval::ContactPairwiseError(gt, trajectory);
-    const auto drift = ihs::eval::CompareTrajectory(gt, trajectory);
-    const auto surface = ihs::eval::CompareWithTruth(gt, mesh, trajectory);
-    std::printf("pairwise registration error at the fingertips: %.2f ± %.2f mm (%d)\n",
-                pairwise.mean_mm, pairwise.std_mm, pairwise.samples);
-    std::printf("object trajectory error: %.2f mm mean, %.2f mm max\n", drift.mean_mm,
-                drift.max_mm);
-    std::printf("surface: Chamfer %.2f mm, completeness %.1f %% (within %.1f mm)\n",
-                surface.chamfer_mm, 100 * surface.completeness, surface.within_mm);
-    out["pairwise_error_mm"] = {
-        {"mean", pairwise.mean_mm}, {"std", pairwise.std_mm}, {"samples", pairwise.samples}};
-    out["trajectory_error_mm"] = {{"mean", drift.mean_mm}, {"max", drift.max_mm}};
-    out["chamfer_mm"] = surface.chamfer_mm;
-    out["completeness"] = surface.completeness;
+    trajectory = ihs::ReadTumTrajectory(trajectory_path);
   }
+  out.update(ihs::eval::ReportScan(object, mesh, mesh, gt, trajectory));
   if (!json_path.empty()) ihs::WriteFileAtomically(json_path, out.dump(1) + "\n");
   return ihs::kExitOk;
 }

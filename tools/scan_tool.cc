@@ -22,6 +22,7 @@
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "core/mesh_io.h"
+#include "core/stopwatch.h"
 #include "core/trajectory_io.h"
 #include "fusion/object_fusion.h"
 #include "fusion/object_mask.h"
@@ -38,12 +39,6 @@
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-double MillisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 struct Args {
   std::string input, out, gt, object, template_name = "procedural";
   bool init_from_gt = false, no_icp = false, contacts_only = false, no_color = false;
@@ -114,7 +109,7 @@ int Run(const Args& args) {
   std::map<std::string, int> track_counts, fusion_counts;
   std::map<std::string, int> skip_reasons;
   std::int64_t index = 0;
-  const auto run_start = Clock::now();
+  const auto run_start = ihs::SteadyClock::now();
   while (args.max_frames <= 0 || index < args.max_frames) {
     const ihs::sensor::SourceRead read = source->Next(std::chrono::seconds(5));
     if (read.status == ihs::sensor::SourceStatus::kTimeout) continue;
@@ -133,7 +128,7 @@ int Run(const Args& args) {
     if (!tracked.joints_mm.empty()) joints.push_back({index, tracked.joints_mm});
 
     // The object's pixels, without the hand model's (grown a little).
-    auto start = Clock::now();
+    auto start = ihs::SteadyClock::now();
     std::vector<std::uint8_t> mask = tracked.segmentation.object_mask;
     if (mask.size() != frame.depth_mm.size()) mask.assign(frame.depth_mm.size(), 0);
     if (tracked.HasPose()) {
@@ -142,17 +137,17 @@ int Run(const Args& args) {
       entry["hand_pixels_removed"] =
           fusion::RemoveMeshPixels(hand, frame, intrinsics, args.hand_dilation_px, 10.0, &mask);
     }
-    entry["mask_ms"] = MillisecondsSince(start);
+    entry["mask_ms"] = ihs::MillisecondsSince(start);
 
     fusion::FusionInput input;
     input.frame = &frame;
     input.object_mask = &mask;
-    start = Clock::now();
+    start = ihs::SteadyClock::now();
     if (!args.contacts_only) {
       input.correspondences.features_2d = sift.Match(frame, mask);
       if (args.features_3d) input.correspondences.features_3d = shot.Match(frame, mask);
     }
-    entry["features_ms"] = MillisecondsSince(start);
+    entry["features_ms"] = ihs::MillisecondsSince(start);
     for (const auto& pair : tracked.contact_pairs) {
       input.correspondences.contacts.push_back({pair.previous_mm, pair.current_mm});
       input.contact_ids.push_back(pair.vertex);
@@ -193,14 +188,14 @@ int Run(const Args& args) {
     ++index;
   }
   if (index == 0) throw ihs::InputError(args.input + ": no frames");
-  const double run_s = MillisecondsSince(run_start) / 1000.0;
+  const double run_s = ihs::MillisecondsSince(run_start) / 1000.0;
 
   // Meshes.
-  auto start = Clock::now();
+  auto start = ihs::SteadyClock::now();
   const ihs::TriangleMesh raw = object_fusion.ExtractMesh();
-  const double marching_cubes_ms = MillisecondsSince(start);
+  const double marching_cubes_ms = ihs::MillisecondsSince(start);
   const fusion::MeshingResult meshes = fusion::MakeMeshes(raw, meshing_options);
-  const double export_ms = MillisecondsSince(start);
+  const double export_ms = ihs::MillisecondsSince(start);
   if (meshes.smoothed.Empty()) throw ihs::InputError(args.input + ": nothing was scanned");
   ihs::WriteMesh(out / "mesh_tsdf.ply", meshes.smoothed);
   if (!meshes.watertight.Empty()) ihs::WriteMesh(out / "mesh.ply", meshes.watertight);
@@ -262,52 +257,11 @@ int Run(const Args& args) {
               meshes.watertight.IsWatertight() ? "watertight" : "NOT watertight");
 
   if (!args.gt.empty()) {
-    nlohmann::json evaluation;
     // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's
     // closing of what was never seen (a base under the hand) is guesswork that would add to a
     // bottle's height. The volume needs the watertight mesh.
-    const ihs::TriangleMesh& scan = meshes.smoothed;
-    if (!object.empty() && object != "box") {
-      const auto rows = ihs::eval::PaperDimensions(object, scan);
-      std::printf("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
-      double sum = 0;
-      for (const auto& row : rows) {
-        std::printf("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm,
-                    row.captured_mm, row.Error());
-        evaluation["dimensions"].push_back(
-            {{"measure", row.measure}, {"truth_mm", row.truth_mm}, {"scan_mm", row.captured_mm}});
-        sum += std::abs(row.Error());
-      }
-      evaluation["dimension_error_mm_mean"] = sum / rows.size();
-      if (object == "sphere" && meshes.watertight.IsWatertight()) {
-        const double truth = ihs::eval::TrueVolume(object);
-        const double volume = meshes.watertight.Volume();
-        std::printf("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%\n", truth, volume,
-                    100 * (volume / truth - 1));
-        evaluation["volume_mm3"] = {{"truth", truth}, {"scan", volume}};
-      }
-    }
-    const ihs::eval::PairwiseError pairwise = ihs::eval::ContactPairwiseError(args.gt, trajectory);
-    std::printf("pairwise registration error at the fingertips: %.2f ± %.2f mm (median %.2f, %d)\n",
-                pairwise.mean_mm, pairwise.std_mm, pairwise.median_mm, pairwise.samples);
-    evaluation["pairwise_error_mm"] = {{"mean", pairwise.mean_mm},
-                                       {"std", pairwise.std_mm},
-                                       {"median", pairwise.median_mm},
-                                       {"samples", pairwise.samples}};
-    const ihs::eval::TrajectoryError drift = ihs::eval::CompareTrajectory(args.gt, trajectory);
-    std::printf("object trajectory error: %.2f mm mean, %.2f mm max, %.2f mm at the end\n",
-                drift.mean_mm, drift.max_mm, drift.final_mm);
-    evaluation["trajectory_error_mm"] = {
-        {"mean", drift.mean_mm}, {"max", drift.max_mm}, {"final", drift.final_mm}};
-    const ihs::fusion::SurfaceComparison surface =
-        ihs::eval::CompareWithTruth(args.gt, scan, trajectory);
-    std::printf(
-        "surface: Chamfer %.2f mm (scan→truth %.2f, truth→scan %.2f), completeness %.1f %%\n",
-        surface.chamfer_mm, surface.scan_to_truth_mm, surface.truth_to_scan_mm,
-        100 * surface.completeness);
-    evaluation["chamfer_mm"] = surface.chamfer_mm;
-    evaluation["completeness"] = surface.completeness;
-    summary["evaluation"] = evaluation;
+    summary["evaluation"] = ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed,
+                                                  meshes.watertight, args.gt, trajectory);
   }
   ihs::WriteFileAtomically(out / "stats.json",
                            nlohmann::json{{"summary", summary}, {"frames", frames}}.dump(1) + "\n");

@@ -10,6 +10,7 @@
 
 #include "core/check.h"
 #include "core/point_kd_tree.h"
+#include "core/stopwatch.h"
 
 namespace ihs::tracker {
 namespace {
@@ -208,12 +209,10 @@ HandFitResult HandTracker::InitialiseFromCloud(const std::vector<Eigen::Vector3f
 }
 
 TrackResult HandTracker::Track(const Frame& frame) {
-  const auto started = std::chrono::steady_clock::now();
+  const auto started = SteadyClock::now();
   TrackResult result;
   auto finish = [&]() {
-    result.milliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
-            .count();
+    result.milliseconds = MillisecondsSince(started);
     return std::move(result);
   };
   if (std::all_of(frame.depth_mm.begin(), frame.depth_mm.end(),
@@ -223,13 +222,10 @@ TrackResult HandTracker::Track(const Frame& frame) {
     has_previous_ = false;
     return finish();
   }
-  auto since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-  };
-  auto stage = std::chrono::steady_clock::now();
+  auto stage = SteadyClock::now();
   result.segmentation = segmenter_.Segment(frame);
-  result.segmentation_ms = since(stage);
-  stage = std::chrono::steady_clock::now();
+  result.segmentation_ms = MillisecondsSince(stage);
+  stage = SteadyClock::now();
   const auto& points = result.segmentation.hand_points;
   if (static_cast<int>(points.size()) < options_.min_hand_points) {
     result.status = TrackStatus::kNoHand;
@@ -275,8 +271,8 @@ TrackResult HandTracker::Track(const Frame& frame) {
   pose_ = result.fit.pose;
   has_pose_ = true;
   if (estimating_scale() && result.HasPose()) EstimateScale(result.segmentation, frame);
-  result.fit_ms = since(stage);
-  stage = std::chrono::steady_clock::now();
+  result.fit_ms = MillisecondsSince(stage);
+  stage = SteadyClock::now();
   result.hand_scale = scale_;
   result.pose = pose_;
   const std::vector<Rigid3> cam_from_bone = ForwardKinematics(model_, pose_);
@@ -312,7 +308,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
       }
     }
   }
-  result.contacts_ms = since(stage);
+  result.contacts_ms = MillisecondsSince(stage);
   previous_vertices_ = vertices;
   previous_contact_vertices_ = result.contacts.vertices;
   std::sort(previous_contact_vertices_.begin(), previous_contact_vertices_.end());
