@@ -17,8 +17,13 @@ CameraIntrinsics CameraIntrinsics::FromFieldOfView(int width, int height, double
   CameraIntrinsics intrinsics;
   intrinsics.width = width;
   intrinsics.height = height;
-  intrinsics.fx = width / (2.0 * std::tan(horizontal_fov_rad / 2.0));
-  intrinsics.fy = height / (2.0 * std::tan(vertical_fov_rad / 2.0));
+  // Rounded to 0.001 px: .oni files store the field of view as a 32-bit float, whose rounding
+  // moves the focal length by ~1e-5 px; rounded, the same camera gives the same intrinsics from
+  // an .oni file as from a TUM folder's text (and the same scan), far below any calibration's
+  // precision.
+  auto round = [](double pixels) { return std::round(pixels * 1000.0) / 1000.0; };
+  intrinsics.fx = round(width / (2.0 * std::tan(horizontal_fov_rad / 2.0)));
+  intrinsics.fy = round(height / (2.0 * std::tan(vertical_fov_rad / 2.0)));
   intrinsics.cx = (width - 1) / 2.0;
   intrinsics.cy = (height - 1) / 2.0;
   return intrinsics;

@@ -25,7 +25,7 @@ struct CameraIntrinsics {
   static CameraIntrinsics Carmine109() { return CameraIntrinsics{}; }
 
   /// Intrinsics from horizontal and vertical fields of view (radians), as OpenNI2 reports them;
-  /// principal point at the image centre.
+  /// principal point at the image centre; focal lengths rounded to 0.001 px.
   static CameraIntrinsics FromFieldOfView(int width, int height, double horizontal_fov_rad,
                                           double vertical_fov_rad);
 

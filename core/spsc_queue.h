@@ -101,8 +101,9 @@ class SpscQueue {
   void Abandon() {
     abandoned_.store(true, std::memory_order_release);
     closed_.store(true, std::memory_order_release);
-    Slot discarded;
-    while (buffer_.try_dequeue(discarded)) {
+    while (true) {
+      Slot discarded = std::nullopt;
+      if (!buffer_.try_dequeue(discarded)) break;
     }
     drained_ = true;
   }

@@ -138,6 +138,24 @@ struct OpenNiSource::Impl : public openni::OpenNI::DeviceDisconnectedListener {
   }
 };
 
+std::string DescribeOpenNiDevices() {
+  try {
+    OpenNiRuntime::Acquire();
+  } catch (const DeviceError& error) {
+    return std::string("OpenNI2: ") + error.what() + "\n";
+  }
+  openni::Array<openni::DeviceInfo> devices;
+  openni::OpenNI::enumerateDevices(&devices);
+  std::string text;
+  if (devices.getSize() == 0) text = "OpenNI2: no device\n";
+  for (int i = 0; i < devices.getSize(); ++i) {
+    text += std::string("OpenNI2: ") + devices[i].getVendor() + " " + devices[i].getName() +
+            " (URI " + devices[i].getUri() + ")\n";
+  }
+  OpenNiRuntime::Release();
+  return text;
+}
+
 OpenNiSource::OpenNiSource(OpenNiOptions options) : options_(std::move(options)) {
   options_.Check();
 }

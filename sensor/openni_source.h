@@ -39,6 +39,10 @@ struct OpenNiOptions {
   void Check() const;
 };
 
+/// What OpenNI2 sees: one line per device (vendor, name, URI), or why it sees none. Never
+/// throws.
+std::string DescribeOpenNiDevices();
+
 /// Reads registered depth (mm) + RGB colour frames through OpenNI2.
 class OpenNiSource : public FrameSource {
  public:

@@ -1,0 +1,317 @@
+// inhandscan: scan an object turned in one hand, live from an OpenNI2 camera or from a
+// recording. Subcommands: live, replay, record, devices, config. See --help.
+
+#include <signal.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/live_screen.h"
+#include "app/pipeline.h"
+#include "app/scanner_options.h"
+#include "core/errors.h"
+#include "core/exit_codes.h"
+#include "core/logging.h"
+#include "render/live_window.h"
+#include "sensor/open_input.h"
+#include "sensor/openni_recorder.h"
+#include "sensor/openni_source.h"
+#include "sensor/paced_source.h"
+#include "sensor/usb_devices.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ihs::app::Pipeline;
+
+// Set by the signal handlers, read by the controlling loop (lock-free atomics are
+// async-signal-safe).
+std::atomic<int> g_stop_signals{0};
+std::atomic<bool> g_export_signal{false};
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
+
+void OnStopSignal(int) {
+  // The first SIGINT/SIGTERM finishes the scan (frames in hand, export); a second exits at once.
+  if (g_stop_signals.fetch_add(1) >= 1) _exit(130);
+}
+
+void OnExportSignal(int) { g_export_signal.store(true); }
+
+void InstallSignalHandlers() {
+  struct sigaction action = {};
+  sigemptyset(&action.sa_mask);
+  action.sa_handler = OnStopSignal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  action.sa_handler = OnExportSignal;
+  sigaction(SIGUSR1, &action, nullptr);
+}
+
+std::string DefaultOutputFolder() {
+  const std::time_t now = std::time(nullptr);
+  std::tm local = {};
+  localtime_r(&now, &local);
+  char name[64];
+  std::strftime(name, sizeof(name), "scan-%Y%m%d-%H%M%S", &local);
+  return name;
+}
+
+// Options shared by live and replay.
+struct ScanArgs {
+  std::string out;
+  std::vector<std::string> formats;
+  bool no_window = false;
+  bool realtime = false;
+  std::string device;
+  std::string input;
+};
+
+std::string StatusLine(const ihs::app::PipelineProgress& progress) {
+  char line[256];
+  const double fps = progress.FramesPerSecond();
+  std::snprintf(line, sizeof(line), "%.1f fps | frames %lld fused %lld dropped %lld | hand: %s",
+                fps, static_cast<long long>(progress.processed),
+                static_cast<long long>(progress.registered),
+                static_cast<long long>(progress.dropped), progress.tracking.c_str());
+  return line;
+}
+
+// Progress for a person: a line rewritten in place on a terminal, a log line every 10 s
+// otherwise.
+class ProgressReporter {
+ public:
+  ProgressReporter() : terminal_(isatty(STDERR_FILENO) != 0) {}
+
+  void Update(const ihs::app::PipelineProgress& progress) {
+    const double fps = progress.FramesPerSecond();
+    std::string done = std::to_string(progress.processed);
+    std::string eta;
+    if (progress.total && *progress.total > 0) {
+      done += "/" + std::to_string(*progress.total);
+      if (fps > 0) {
+        const double left = (*progress.total - progress.processed) / fps;
+        eta = ", ETA " + std::to_string(static_cast<long long>(std::ceil(std::max(0.0, left)))) +
+              " s";
+      }
+    }
+    char line[256];
+    std::snprintf(line, sizeof(line), "frames %s, %.1f fps, fused %lld, dropped %lld%s",
+                  done.c_str(), fps, static_cast<long long>(progress.registered),
+                  static_cast<long long>(progress.dropped), eta.c_str());
+    if (terminal_) {
+      std::fprintf(stderr, "\r%-78s", line);
+      shown_ = true;
+    } else if (progress.seconds - last_log_s_ >= 10.0) {
+      last_log_s_ = progress.seconds;
+      spdlog::info("{}", line);
+    }
+  }
+
+  void Done() {
+    if (shown_) std::fprintf(stderr, "\n");
+    shown_ = false;
+  }
+
+ private:
+  const bool terminal_;
+  bool shown_ = false;
+  double last_log_s_ = 0;
+};
+
+// Runs a pipeline to its end: signals (and the window's keys) become requests; returns the
+// exit code after printing where the mesh is.
+int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
+                ihs::render::LiveWindow* window, bool quiet) {
+  ProgressReporter reporter;
+  bool stop_sent = false;
+  while (!pipeline.Wait(std::chrono::milliseconds(window ? 15 : 100))) {
+    if (g_export_signal.exchange(false)) {
+      spdlog::info("export requested");
+      pipeline.RequestExport();
+    }
+    if (g_stop_signals.load() > 0 && !stop_sent) {
+      spdlog::info("stopping: finishing the frames in hand, then exporting");
+      pipeline.RequestStop();
+      stop_sent = true;
+    }
+    const ihs::app::PipelineProgress progress = pipeline.Progress();
+    if (window) {
+      for (char key : window->PollKeys()) {
+        if (key == 's') pipeline.RequestExport();
+        if (key == 'r') pipeline.RequestReset();
+        if (key == 'q' && !stop_sent) pipeline.RequestStop(), stop_sent = true;
+      }
+      if (window->ShouldClose() && !stop_sent) pipeline.RequestStop(), stop_sent = true;
+      if (auto view = pipeline.TakeLiveView()) {
+        const ihs::app::RgbImage screen =
+            ihs::app::ComposeLiveScreen(*view, intrinsics, StatusLine(progress));
+        window->Show(screen.rgb, screen.width, screen.height);
+      }
+    } else if (!quiet) {
+      reporter.Update(progress);
+    }
+  }
+  reporter.Done();
+  const ihs::app::PipelineResult result = pipeline.Finish();
+  const auto& p = result.progress;
+  spdlog::info("{} frames ({}): {} fused, {} dropped, {:.1f} frames/s, {:.1f} s in all",
+               p.processed, result.end_reason, p.registered, p.dropped, p.FramesPerSecond(),
+               p.seconds);
+  for (const fs::path& file : result.files) {
+    if (file.filename() == "mesh.ply") std::printf("mesh: %s\n", file.c_str());
+  }
+  if (!result.error.empty()) std::fprintf(stderr, "inhandscan: error: %s\n", result.error.c_str());
+  return result.exit_code;
+}
+
+int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOptions options,
+         const ScanArgs& args, bool want_window, bool quiet) {
+  ihs::app::PipelineOutput output;
+  output.folder = args.out.empty() ? DefaultOutputFolder() : args.out;
+  output.extra_formats = args.formats;
+  output.live_view = want_window;
+  Pipeline pipeline(std::move(source), std::move(options), output);
+  pipeline.Start();
+  std::unique_ptr<ihs::render::LiveWindow> window;
+  if (want_window) {
+    try {
+      window = std::make_unique<ihs::render::LiveWindow>("inhandscan", 1280, 508);
+    } catch (const ihs::DeviceError& error) {
+      spdlog::warn("{}; scanning without a window (export: kill -USR1 {}; stop: Ctrl-C)",
+                   error.what(), getpid());
+    }
+  }
+  spdlog::info("scanning into {} (export now: kill -USR1 {}; stop: Ctrl-C)", output.folder.string(),
+               getpid());
+  return RunPipeline(pipeline, pipeline.intrinsics(), window.get(), quiet);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "inhandscan: scan a small object into a watertight 3D mesh while you turn it in "
+      "one hand in front of a depth camera (Tzionas & Gall, ICCV 2015).",
+      "inhandscan"};
+  app.footer(ihs::ExitCodesHelp());
+  app.set_version_flag("--version", std::string("inhandscan ") + IHS_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();  // Global options may also follow the subcommand.
+  std::string log_level = "info";
+  bool quiet = false;
+  std::string config_file;
+  std::vector<std::string> assignments;
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  app.add_flag("-q,--quiet", quiet, "only warnings and errors, no progress");
+  app.add_option("--config", config_file,
+                 "options file (NAME = VALUE lines; `inhandscan config` prints every option)");
+  app.add_option("--set", assignments, "set one option: NAME=VALUE (repeatable; after --config)");
+
+  ScanArgs args;
+  auto add_output = [&](CLI::App* command) {
+    command->add_option("--out", args.out, "output folder (default: scan-DATE-TIME)");
+    command->add_option("--format", args.formats, "also write the mesh as obj and/or stl")
+        ->check(CLI::IsMember({"obj", "stl", "ply"}))
+        ->delimiter(',');
+  };
+  CLI::App* live = app.add_subcommand("live", "scan with a Carmine 1.09 (or any OpenNI2 camera)");
+  live->add_option("--device", args.device, "device URI (default: the first one)");
+  live->add_flag("--no-window", args.no_window, "headless: export on SIGUSR1, stop on Ctrl-C");
+  add_output(live);
+  CLI::App* replay =
+      app.add_subcommand("replay", "scan a recording (.oni or TUM folder), headless");
+  replay->add_option("input", args.input, ".oni file or TUM RGB-D folder")->required();
+  replay->add_flag("--realtime", args.realtime,
+                   "pace frames at their timestamps and drop frames as live would");
+  add_output(replay);
+  std::string record_path;
+  double record_seconds = 0;
+  CLI::App* record = app.add_subcommand("record", "record the camera to an .oni file");
+  record->add_option("output", record_path, ".oni file to write")->required();
+  record->add_option("--seconds", record_seconds, "stop after this long (default: Ctrl-C)")
+      ->check(CLI::PositiveNumber);
+  record->add_option("--device", args.device, "device URI (default: the first one)");
+  CLI::App* devices = app.add_subcommand("devices", "list cameras on USB and what OpenNI2 sees");
+  CLI::App* config =
+      app.add_subcommand("config", "print every option with its default and meaning");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0) return app.exit(error);
+    std::fprintf(stderr, "inhandscan: error: %s (see --help)\n", error.what());
+    return ihs::kExitUsage;
+  }
+  return ihs::RunReportingErrors("inhandscan", [&]() -> int {
+    ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
+    ihs::app::ScannerOptions options;
+    ihs::app::OptionRegistry registry = ihs::app::RegisterScannerOptions(&options);
+    if (!config_file.empty()) registry.Load(config_file);
+    for (const std::string& assignment : assignments) registry.SetAssignment(assignment);
+    options.Check();
+    if (config->parsed()) {
+      std::printf("# inhandscan %s options (a valid --config file; defaults are the paper's)\n%s",
+                  IHS_VERSION, registry.Describe().c_str());
+      return ihs::kExitOk;
+    }
+    if (devices->parsed()) {
+      bool ready = false;
+      std::printf(
+          "%s", ihs::sensor::DescribeUsbScan(ihs::sensor::ScanPrimeSenseDevices(), &ready).c_str());
+      std::printf("%s", ihs::sensor::DescribeOpenNiDevices().c_str());
+      return ready ? ihs::kExitOk : ihs::kExitDevice;
+    }
+    InstallSignalHandlers();
+    if (record->parsed()) {
+      ihs::sensor::OpenNiOptions device;
+      device.uri = args.device;
+      std::atomic<bool> stop{false};
+      const auto max_duration =
+          record_seconds > 0
+              ? std::chrono::milliseconds(static_cast<long long>(record_seconds * 1000))
+              : std::chrono::milliseconds::max();
+      // The recorder polls `stop`; the signal handler only counts signals.
+      std::thread watcher([&] {
+        while (!stop.load()) {
+          if (g_stop_signals.load() > 0) stop.store(true);
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+      });
+      ihs::sensor::RecordingSummary summary;
+      try {
+        summary = ihs::sensor::RecordWithOpenNi(device, record_path, max_duration, 0, stop);
+      } catch (...) {
+        stop.store(true);
+        watcher.join();
+        throw;
+      }
+      stop.store(true);
+      watcher.join();
+      std::printf("recorded %lld frames (%.1f s) to %s\n",
+                  static_cast<long long>(summary.depth_frames), summary.seconds,
+                  record_path.c_str());
+      return ihs::kExitOk;
+    }
+    if (live->parsed()) {
+      ihs::sensor::OpenNiOptions device;
+      device.uri = args.device;
+      return Scan(std::make_unique<ihs::sensor::OpenNiSource>(device), options, args,
+                  !args.no_window, quiet);
+    }
+    ihs::sensor::InputOptions input_options;
+    input_options.pacing =
+        args.realtime ? ihs::sensor::Pacing::kRealTime : ihs::sensor::Pacing::kAsFastAsPossible;
+    return Scan(ihs::sensor::OpenInput(args.input, input_options), options, args, false, quiet);
+  });
+}

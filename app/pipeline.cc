@@ -1,0 +1,466 @@
+#include "app/pipeline.h"
+
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "app/scan_export.h"
+#include "app/scan_record.h"
+#include "app/scan_stages.h"
+#include "core/errors.h"
+#include "core/exit_codes.h"
+#include "core/spsc_queue.h"
+#include "core/stopwatch.h"
+
+namespace ihs::app {
+namespace {
+
+using PacketPtr = std::unique_ptr<FramePacket>;
+
+// A snapshot for the export thread: a preview or a mesh export.
+struct ExportJob {
+  enum class Kind { kPreview, kExport, kFinal } kind = Kind::kExport;
+  TriangleMesh model;  // Raw marching cubes, object frame.
+  // Previews: what the camera saw and where the model and the hand were.
+  std::shared_ptr<const Frame> frame;
+  std::shared_ptr<const TriangleMesh> hand;
+  Rigid3 cam_from_object;
+  // Exports: the scan's log so far.
+  std::shared_ptr<const ScanRecord> record;
+};
+using JobPtr = std::unique_ptr<ExportJob>;
+
+// The model seen from the camera, shaded by the angle to the view ray, in its colours.
+RgbImage ShadedRaycast(const fusion::TsdfVolume& volume, const CameraIntrinsics& intrinsics,
+                       const Rigid3& cam_from_object) {
+  const fusion::RaycastImage cast = volume.Raycast(intrinsics, cam_from_object);
+  RgbImage image{cast.width, cast.height, {}};
+  image.rgb.assign(static_cast<std::size_t>(cast.width) * cast.height * 3, 0);
+  for (std::size_t i = 0; i < cast.depth_mm.size(); ++i) {
+    if (cast.depth_mm[i] <= 0) continue;
+    const float shade = 0.25f + 0.75f * std::abs(cast.normals[i].z());
+    const bool colored = i < cast.colors.size();
+    for (int c = 0; c < 3; ++c) {
+      const float base = colored ? cast.colors[i][c] : 200.0f;
+      image.rgb[i * 3 + c] = static_cast<std::uint8_t>(std::min(255.0f, base * shade));
+    }
+  }
+  return image;
+}
+
+// The process's peak resident memory so far, MiB.
+double PeakResidentMiB() {
+  rusage usage = {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // ru_maxrss is in KiB on Linux.
+}
+
+int ExitCodeOf(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const InputError&) {
+    return kExitInput;
+  } catch (const DeviceError&) {
+    return kExitDevice;
+  } catch (const OutputError&) {
+    return kExitOutput;
+  } catch (...) {
+    return kExitStageFailed;
+  }
+}
+
+std::string MessageOf(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "unknown error";
+  }
+}
+
+}  // namespace
+
+struct Pipeline::Shared {
+  Shared(std::size_t capacity) : frames(capacity), tracked(capacity), jobs(2) {}
+
+  SpscQueue<PacketPtr> frames;   // capture → tracker
+  SpscQueue<PacketPtr> tracked;  // tracker → fusion
+  SpscQueue<JobPtr> jobs;        // fusion → export
+  CameraIntrinsics intrinsics;
+  std::unique_ptr<HandStage> hand;
+  std::vector<std::string> bone_names;
+  std::vector<int> joint_parents;  // Joint j+1 ends bone j, which starts where its parent ends.
+  std::chrono::steady_clock::time_point start;
+  bool live = false;
+
+  std::atomic<std::int64_t> captured{0}, processed{0}, registered{0}, exports{0};
+  std::atomic<double> processing_seconds{0};  // From Start() to the last frame fused.
+  std::atomic<std::int64_t> dropped_capture{0}, dropped_tracker{0}, previews_skipped{0};
+  mutable std::mutex mutex;  // Guards what follows.
+  std::condition_variable done;
+  std::string tracking = "waiting";
+  std::string end_reason;
+  std::string failed_stage;
+  std::exception_ptr failure;
+  std::vector<std::filesystem::path> final_files;
+  bool final_export_done = false;
+  int running = 0;  // Threads still running.
+};
+
+Pipeline::Pipeline(std::unique_ptr<sensor::FrameSource> source, ScannerOptions options,
+                   PipelineOutput output)
+    : source_(std::move(source)), options_(std::move(options)), output_(std::move(output)) {
+  options_.Check();
+  if (!source_) throw std::invalid_argument("Pipeline: no frame source");
+  shared_ = std::make_unique<Shared>(options_.pipeline.queue_capacity);
+}
+
+Pipeline::~Pipeline() {
+  if (started_ && !finished_) {
+    RequestStop();
+    for (std::thread& thread : threads_) {
+      if (thread.joinable()) thread.join();
+    }
+  }
+  if (source_) source_->Stop();
+}
+
+void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) {
+  if (started_) throw std::logic_error("Pipeline::Start called twice");
+  std::error_code error;
+  std::filesystem::create_directories(output_.folder, error);
+  if (error || !std::filesystem::is_directory(output_.folder)) {
+    throw OutputError(output_.folder.string() + ": cannot create the output folder" +
+                      (error ? " (" + error.message() + ")" : ""));
+  }
+  if (options_.pipeline.preview_every > 0) {
+    std::filesystem::create_directories(output_.folder / "preview", error);
+  }
+  source_->Start();
+  shared_->intrinsics = source_->Intrinsics();
+  shared_->live = source_->IsLive();
+  shared_->hand = std::make_unique<HandStage>(options_, shared_->intrinsics);
+  shared_->bone_names = shared_->hand->BoneNames();
+  shared_->joint_parents = {-1};
+  for (const auto& bone : shared_->hand->model().bones) {
+    shared_->joint_parents.push_back(bone.parent < 0 ? 0 : bone.parent + 1);
+  }
+  if (initial_hand_pose) shared_->hand->Initialise(*initial_hand_pose);
+  shared_->start = SteadyClock::now();
+  started_ = true;
+  shared_->running = 4;
+  threads_.emplace_back([this] { CaptureLoop(); });
+  threads_.emplace_back([this] { TrackerLoop(); });
+  threads_.emplace_back([this] { FusionLoop(); });
+  threads_.emplace_back([this] { ExportLoop(); });
+}
+
+void Pipeline::ThreadDone() {
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    --shared_->running;
+  }
+  shared_->done.notify_all();
+}
+
+void Pipeline::Fail(const std::string& stage, std::exception_ptr error) {
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    if (!shared_->failure) {
+      shared_->failure = error;
+      shared_->failed_stage = stage;
+    }
+  }
+  spdlog::error("{} failed: {}", stage, MessageOf(error));
+  RequestStop();
+}
+
+void Pipeline::CaptureLoop() {
+  Shared& s = *shared_;
+  std::string end_reason = "end of stream";
+  try {
+    std::int64_t read_frames = 0;
+    while (true) {
+      if (stop_requested_.load()) {
+        end_reason = "stopped";
+        break;
+      }
+      if (options_.pipeline.max_frames > 0 && read_frames >= options_.pipeline.max_frames) {
+        end_reason = "frame limit";
+        break;
+      }
+      const sensor::SourceRead read = source_->Next(std::chrono::milliseconds(200));
+      if (read.status == sensor::SourceStatus::kTimeout) continue;
+      if (read.status == sensor::SourceStatus::kEndOfStream) break;
+      if (read.status == sensor::SourceStatus::kDisconnected) {
+        end_reason = "disconnected" + (read.message.empty() ? "" : ": " + read.message);
+        Fail("capture", std::make_exception_ptr(DeviceError(end_reason)));
+        break;
+      }
+      ++read_frames;
+      ++s.captured;
+      auto packet = std::make_unique<FramePacket>();
+      packet->frame = read.frame;
+      packet->captured_at = SteadyClock::now();
+      if (s.live) {
+        if (!s.frames.TryPush(std::move(packet))) ++s.dropped_capture;
+      } else if (!s.frames.Push(std::move(packet))) {
+        break;  // The tracker has stopped.
+      }
+    }
+  } catch (...) {
+    end_reason = "failed";
+    Fail("capture", std::current_exception());
+  }
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.end_reason = end_reason;
+  }
+  s.frames.Close();
+  ThreadDone();
+}
+
+void Pipeline::TrackerLoop() {
+  Shared& s = *shared_;
+  try {
+    PacketPtr packet;
+    while (s.frames.Pop(packet) == PopStatus::kItem) {
+      s.hand->Process(*packet);
+      {
+        std::lock_guard<std::mutex> lock(s.mutex);
+        s.tracking = packet->frame_error.empty() ? tracker::ToString(packet->track.status)
+                                                 : "malformed frame";
+      }
+      if (s.live) {
+        if (!s.tracked.TryPush(std::move(packet))) ++s.dropped_tracker;
+      } else if (!s.tracked.Push(std::move(packet))) {
+        break;  // The fusion thread has stopped.
+      }
+    }
+  } catch (...) {
+    Fail("tracker", std::current_exception());
+  }
+  s.frames.Abandon();  // Releases a capture thread blocked on a full queue.
+  s.tracked.Close();
+  ThreadDone();
+}
+
+void Pipeline::FusionLoop() {
+  Shared& s = *shared_;
+  std::unique_ptr<ObjectStage> object;
+  auto record = std::make_shared<ScanRecord>(s.bone_names);
+  std::int64_t previewed_at = 0;
+  std::int64_t live_view_frame = -1000;
+  // Hands a snapshot to the export thread; false when it is busy (try again later).
+  auto submit = [&](ExportJob::Kind kind, const FramePacket* packet) {
+    auto job = std::make_unique<ExportJob>();
+    job->kind = kind;
+    if (object) job->model = object->Snapshot();
+    if (kind == ExportJob::Kind::kPreview) {
+      job->frame = packet->frame;
+      job->hand = packet->hand_mesh;
+      job->cam_from_object = packet->fusion.cam_from_object;
+    } else {
+      job->record = std::make_shared<ScanRecord>(*record);
+    }
+    if (kind == ExportJob::Kind::kFinal) return s.jobs.Push(std::move(job));
+    return s.jobs.TryPush(std::move(job));
+  };
+  try {
+    object = std::make_unique<ObjectStage>(options_, s.intrinsics);
+    PacketPtr packet;
+    while (true) {
+      const PopStatus status = s.tracked.Pop(packet, std::chrono::milliseconds(50));
+      if (reset_requested_.exchange(false)) {
+        spdlog::info("reset: the model starts anew");
+        object = std::make_unique<ObjectStage>(options_, s.intrinsics);
+        record = std::make_shared<ScanRecord>(s.bone_names);
+        s.registered = 0;
+      }
+      if (export_requested_.load() && object->started() &&
+          submit(ExportJob::Kind::kExport, nullptr)) {
+        export_requested_.store(false);
+      }
+      if (status == PopStatus::kTimeout) continue;
+      if (status == PopStatus::kClosed) break;
+      object->Process(*packet);
+      packet->latency_ms = MillisecondsSince(packet->captured_at);
+      record->Add(*packet);
+      ++s.processed;
+      s.processing_seconds = MillisecondsSince(s.start) / 1000.0;
+      if (!packet->Registered()) continue;
+      const std::int64_t registered = ++s.registered;
+      const int every = options_.pipeline.preview_every;
+      if (every > 0 && registered - previewed_at >= every) {
+        if (submit(ExportJob::Kind::kPreview, packet.get())) {
+          previewed_at = registered;
+        } else {
+          ++s.previews_skipped;
+        }
+      }
+      if (output_.live_view && packet->frame->index - live_view_frame >= 3) {
+        live_view_frame = packet->frame->index;
+        LiveView view;
+        view.frame = packet->frame;
+        view.joints_mm = packet->track.joints_mm;
+        view.joint_parents = s.joint_parents;
+        for (const auto& pair : packet->track.contact_pairs)
+          view.contacts_mm.push_back(pair.current_mm);
+        view.model = ShadedRaycast(object->volume(), s.intrinsics, packet->fusion.cam_from_object);
+        view.tracking = tracker::ToString(packet->track.status);
+        live_view_.Put(std::move(view));
+      }
+    }
+  } catch (...) {
+    Fail("fusion", std::current_exception());
+  }
+  s.tracked.Abandon();  // Releases a tracker thread blocked on a full queue.
+  try {
+    submit(ExportJob::Kind::kFinal, nullptr);
+  } catch (...) {
+    Fail("fusion (final snapshot)", std::current_exception());
+  }
+  s.jobs.Close();
+  ThreadDone();
+}
+
+void Pipeline::ExportLoop() {
+  Shared& s = *shared_;
+  std::unique_ptr<PreviewRenderer> previews;
+  bool previews_failed = false;
+  JobPtr job;
+  while (s.jobs.Pop(job) == PopStatus::kItem) {
+    try {
+      if (job->kind == ExportJob::Kind::kPreview) {
+        if (previews_failed) continue;
+        try {
+          if (!previews) previews = std::make_unique<PreviewRenderer>(s.intrinsics);
+        } catch (const std::exception& error) {
+          spdlog::warn("no preview images: {}", error.what());
+          previews_failed = true;
+          continue;
+        }
+        char name[32];
+        std::snprintf(name, sizeof(name), "%06lld.png", static_cast<long long>(job->frame->index));
+        WritePng(output_.folder / "preview" / name,
+                 previews->Draw(*job->frame, job->model, job->cam_from_object, job->hand.get()));
+        continue;
+      }
+      const bool final = job->kind == ExportJob::Kind::kFinal;
+      const ExportedMeshes exported =
+          ExportMeshes(job->model, options_.meshing, output_.folder, output_.extra_formats);
+      job->record->WriteTables(output_.folder);
+      const PipelineProgress progress = Progress();
+      nlohmann::json extra = {{"source", source_->Description()},
+                              {"live", s.live},
+                              {"final", final},
+                              {"captured_frames", progress.captured},
+                              {"dropped_frames",
+                               {{"capture_queue_full", s.dropped_capture.load()},
+                                {"tracker_queue_full", s.dropped_tracker.load()}}},
+                              {"previews_skipped", s.previews_skipped.load()},
+                              {"seconds", progress.seconds},
+                              {"processing_seconds", progress.processing_seconds},
+                              {"frames_per_second", progress.FramesPerSecond()},
+                              {"peak_rss_mib", PeakResidentMiB()},
+                              {"hand_scale", s.hand->scale()},
+                              {"export_ms",
+                               {{"total", exported.milliseconds},
+                                {"cleanup", exported.meshes.cleanup_ms},
+                                {"smoothing", exported.meshes.smoothing_ms},
+                                {"poisson", exported.meshes.poisson_ms}}},
+                              {"mesh",
+                               {{"faces", exported.meshes.watertight.faces.size()},
+                                {"watertight", exported.meshes.watertight.IsWatertight()},
+                                {"volume_mm3", exported.meshes.watertight.IsWatertight()
+                                                   ? exported.meshes.watertight.Volume()
+                                                   : 0.0}}}};
+      {
+        std::lock_guard<std::mutex> lock(s.mutex);
+        if (!s.end_reason.empty()) extra["end_reason"] = s.end_reason;
+        if (s.failure) extra["failure"] = s.failed_stage + ": " + MessageOf(s.failure);
+      }
+      job->record->WriteStats(output_.folder / "stats.json", extra);
+      ++s.exports;
+      if (exported.files.empty()) {
+        spdlog::warn("export: nothing to mesh yet");
+      } else {
+        spdlog::info("exported {} ({} faces, {:.1f} s)", exported.files.back().string(),
+                     exported.meshes.watertight.faces.size(), exported.milliseconds / 1000.0);
+      }
+      if (final) {
+        std::lock_guard<std::mutex> lock(s.mutex);
+        s.final_files = exported.files;
+        s.final_export_done = true;
+      }
+    } catch (...) {
+      Fail("export", std::current_exception());
+    }
+  }
+  ThreadDone();
+}
+
+bool Pipeline::Wait(std::chrono::milliseconds timeout) {
+  if (!started_) return true;
+  std::unique_lock<std::mutex> lock(shared_->mutex);
+  return shared_->done.wait_for(lock, timeout, [this] { return shared_->running == 0; });
+}
+
+PipelineProgress Pipeline::Progress() const {
+  const Shared& s = *shared_;
+  PipelineProgress progress;
+  progress.captured = s.captured.load();
+  progress.processed = s.processed.load();
+  progress.registered = s.registered.load();
+  progress.dropped = s.dropped_capture.load() + s.dropped_tracker.load();
+  progress.exports = s.exports.load();
+  if (source_) progress.total = source_->FrameCount();
+  if (started_) progress.seconds = MillisecondsSince(s.start) / 1000.0;
+  progress.processing_seconds = s.processing_seconds.load();
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    progress.tracking = s.tracking;
+  }
+  return progress;
+}
+
+CameraIntrinsics Pipeline::intrinsics() const { return shared_->intrinsics; }
+
+PipelineResult Pipeline::Finish() {
+  PipelineResult result;
+  if (!started_) throw std::logic_error("Pipeline::Finish before Start");
+  if (!finished_) {
+    for (std::thread& thread : threads_) thread.join();
+    finished_ = true;
+    source_->Stop();
+  }
+  Shared& s = *shared_;
+  result.progress = Progress();
+  std::lock_guard<std::mutex> lock(s.mutex);
+  result.end_reason = s.end_reason;
+  result.files = s.final_files;
+  if (s.failure) {
+    result.exit_code = ExitCodeOf(s.failure);
+    result.error = s.failed_stage + ": " + MessageOf(s.failure);
+    if (result.files.empty())
+      result.error += " (nothing could be saved)";
+    else
+      result.error += " (the model so far was saved)";
+  } else if (result.progress.captured == 0) {
+    result.exit_code = kExitInput;
+    result.error = source_->Description() + ": no frames";
+  } else if (result.files.empty()) {
+    result.exit_code = kExitStageFailed;
+    result.error =
+        "nothing was scanned: no frame could be registered (see stats.json's skip_reasons)";
+  }
+  return result;
+}
+
+}  // namespace ihs::app

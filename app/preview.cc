@@ -1,0 +1,78 @@
+#include "app/preview.h"
+
+#include <algorithm>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <ostream>
+
+#include "core/atomic_file.h"
+#include "core/errors.h"
+#include "render/offscreen_renderer.h"
+
+namespace ihs::app {
+
+PreviewRenderer::PreviewRenderer(const CameraIntrinsics& intrinsics) {
+  render::RendererOptions options;
+  options.background = {40, 40, 48};
+  renderer_ = std::make_unique<render::OffscreenRenderer>(intrinsics, options);
+}
+
+PreviewRenderer::~PreviewRenderer() = default;
+
+RgbImage PreviewRenderer::Draw(const Frame& frame, const TriangleMesh& model,
+                               const Rigid3& cam_from_object, const TriangleMesh* hand) {
+  std::vector<render::RenderItem> items;
+  if (!model.faces.empty()) {
+    render::RenderItem item;
+    item.mesh = &model;
+    item.cam_from_mesh = cam_from_object;
+    item.use_vertex_colors = !model.colors.empty();
+    items.push_back(item);
+  }
+  if (hand && !hand->faces.empty()) {
+    render::RenderItem item;
+    item.mesh = hand;
+    item.color = {225, 170, 140};
+    item.label = render::kHand;
+    items.push_back(item);
+  }
+  const render::RenderOutput rendered = renderer_->Render(items);
+  const int width = rendered.width, height = rendered.height;
+
+  RgbImage image;
+  image.width = 2 * width;
+  image.height = height;
+  image.rgb.assign(static_cast<std::size_t>(image.width) * height * 3, 0);
+  const bool same_size = frame.width == width && frame.height == height;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      std::uint8_t* left = &image.rgb[(static_cast<std::size_t>(v) * image.width + u) * 3];
+      if (same_size && frame.HasColor()) {
+        std::copy_n(&frame.rgb[(static_cast<std::size_t>(v) * width + u) * 3], 3, left);
+      } else if (same_size) {
+        const int depth = frame.DepthAt(u, v);
+        const auto grey = static_cast<std::uint8_t>(depth ? 255 - std::min(depth / 6, 230) : 0);
+        std::fill_n(left, 3, grey);
+      }
+      std::copy_n(&rendered.rgb[(static_cast<std::size_t>(v) * width + u) * 3], 3,
+                  left + width * 3);
+    }
+  }
+  return image;
+}
+
+void WritePng(const std::filesystem::path& path, const RgbImage& image) {
+  cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.rgb.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  std::vector<std::uint8_t> bytes;
+  if (!cv::imencode(".png", bgr, bytes)) {
+    throw OutputError(path.string() + ": cannot encode the image");
+  }
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+}  // namespace ihs::app

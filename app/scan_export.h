@@ -1,0 +1,31 @@
+#pragma once
+// Turning the model into the files a user keeps: the raw marching-cubes mesh cleaned, smoothed
+// and closed (fusion/surface_mesh.h), written as mesh_tsdf.ply (the surface that was seen) and
+// mesh.ply (watertight), plus the same watertight mesh in any extra formats asked for.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/triangle_mesh.h"
+#include "fusion/surface_mesh.h"
+
+namespace ihs::app {
+
+/// What an export wrote.
+struct ExportedMeshes {
+  fusion::MeshingResult meshes;
+  /// Files written, in order.
+  std::vector<std::filesystem::path> files;
+  /// Meshing and writing, ms.
+  double milliseconds = 0;
+};
+
+/// Meshes `raw` with `options` and writes mesh_tsdf.ply, mesh.ply (when Poisson gave a mesh) and
+/// mesh.<ext> for each of `extra_formats` ("obj", "stl", "ply") into `folder`. Nothing is written
+/// when `raw` has no faces. Throws ihs::OutputError when a file cannot be written.
+ExportedMeshes ExportMeshes(const TriangleMesh& raw, const fusion::MeshingOptions& options,
+                            const std::filesystem::path& folder,
+                            const std::vector<std::string>& extra_formats = {});
+
+}  // namespace ihs::app

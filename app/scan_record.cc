@@ -1,0 +1,144 @@
+#include "app/scan_record.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+
+namespace ihs::app {
+namespace {
+
+double Percentile(std::vector<double> values, double fraction) {
+  if (values.empty()) return 0.0;
+  const std::size_t k =
+      std::min(values.size() - 1, static_cast<std::size_t>(fraction * values.size()));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+}  // namespace
+
+ScanRecord::ScanRecord(std::vector<std::string> bone_names) : bone_names_(std::move(bone_names)) {}
+
+void ScanRecord::Add(const FramePacket& packet) {
+  const Frame& frame = *packet.frame;
+  nlohmann::json entry = {{"frame", frame.index}, {"timestamp_us", frame.depth_timestamp_us}};
+  auto timing = [&](const char* key, double ms) {
+    entry[key] = ms;
+    auto& [sum, count] = stage_ms_[key];
+    sum += ms;
+    ++count;
+  };
+  if (!packet.frame_error.empty()) {
+    entry["track"] = "malformed";
+    ++track_counts_["malformed"];
+  } else {
+    const tracker::TrackResult& track = packet.track;
+    entry["track"] = tracker::ToString(track.status);
+    ++track_counts_[tracker::ToString(track.status)];
+    if (!track.reason.empty()) entry["track_reason"] = track.reason;
+    timing("track_ms", track.milliseconds);
+    timing("mask_ms", packet.mask_ms);
+    timing("features_ms", packet.features_ms);
+    entry["hand_pixels_removed"] = packet.hand_pixels_removed;
+    entry["sift_matches"] = packet.sift_matches;
+    entry["shot_matches"] = packet.shot_matches;
+    entry["contact_pairs"] = packet.contact_pairs;
+    if (!track.joints_mm.empty()) joints_.push_back({frame.index, track.joints_mm});
+    if (track.HasPose()) {
+      const Eigen::Quaterniond q = track.pose.cam_from_root.quaternion();
+      const Eigen::Vector3d t = track.pose.cam_from_root.translation();
+      std::string row = std::to_string(frame.index);
+      char buffer[48];
+      for (double value : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) {
+        std::snprintf(buffer, sizeof(buffer), ",%.6g", value);
+        row += buffer;
+      }
+      for (double angle : track.pose.angles_rad) {
+        std::snprintf(buffer, sizeof(buffer), ",%.6g", angle);
+        row += buffer;
+      }
+      pose_rows_.push_back(std::move(row));
+    }
+  }
+  const fusion::FusionResult& fused = packet.fusion;
+  entry["fusion"] = fusion::ToString(fused.status);
+  ++fusion_counts_[fusion::ToString(fused.status)];
+  if (packet.frame_error.empty()) {
+    timing("fusion_ms", fused.milliseconds);
+    timing("pairwise_ms", fused.pairwise_ms);
+    timing("raycast_ms", fused.raycast_ms);
+    timing("icp_ms", fused.icp_ms);
+    timing("integrate_ms", fused.integrate_ms);
+    entry["anchored_contacts"] = fused.anchored_contacts;
+    entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;
+    if (fused.pairwise.ok) entry["pairwise_rms_mm"] = fused.pairwise.rms_mm;
+    if (fused.icp_from_previous) entry["icp_from_previous"] = true;
+    if (fused.icp.iterations > 0) {
+      entry["icp_inliers"] = fused.icp.inliers;
+      entry["icp_rms_mm"] = fused.icp.rms_mm;
+    }
+  }
+  if (packet.latency_ms > 0) {
+    entry["latency_ms"] = packet.latency_ms;
+    latencies_ms_.push_back(packet.latency_ms);
+  }
+  if (fused.status == fusion::FusionStatus::kSkipped) {
+    entry["fusion_reason"] = fused.reason;
+    ++skip_reasons_[fused.reason.substr(0, fused.reason.find(':'))];
+  } else {
+    trajectory_.push_back({frame.depth_timestamp_us * 1e-6, fused.cam_from_object});
+  }
+  frame_json_.push_back(entry.dump());
+  ++frames_;
+}
+
+nlohmann::json ScanRecord::Summary() const {
+  nlohmann::json ms = nlohmann::json::object();
+  for (const auto& [key, sum_count] : stage_ms_) {
+    const std::string name = key.substr(0, key.size() - 3);  // "track_ms" → "track".
+    ms[name] = sum_count.second ? sum_count.first / sum_count.second : 0.0;
+  }
+  nlohmann::json summary = {{"frames", frames_},
+                            {"registered_frames", registered()},
+                            {"track_status_counts", track_counts_},
+                            {"fusion_status_counts", fusion_counts_},
+                            {"skip_reasons", skip_reasons_},
+                            {"ms_per_frame", ms}};
+  if (!latencies_ms_.empty()) {
+    summary["latency_ms"] = {
+        {"p50", Percentile(latencies_ms_, 0.5)},
+        {"p95", Percentile(latencies_ms_, 0.95)},
+        {"max", *std::max_element(latencies_ms_.begin(), latencies_ms_.end())}};
+  }
+  return summary;
+}
+
+void ScanRecord::WriteTables(const std::filesystem::path& folder) const {
+  WriteTumTrajectory(folder / "trajectory.txt", trajectory_,
+                     {"cam_from_object of the scanned object (mm), registered frames only",
+                      "timestamp tx ty tz qx qy qz qw"});
+  tracker::WriteHandJointsCsv(folder / "hand_joints.csv", bone_names_, joints_);
+  std::string poses =
+      "# hand pose per tracked frame: cam_from_root (mm; quaternion x y z w), then the joint "
+      "angles (rad) in the template's degree-of-freedom "
+      "order\nframe,tx,ty,tz,qx,qy,qz,qw,angles...\n";
+  for (const std::string& row : pose_rows_) poses += row + "\n";
+  WriteFileAtomically(folder / "hand_poses.csv", poses);
+}
+
+void ScanRecord::WriteStats(const std::filesystem::path& path, const nlohmann::json& extra) const {
+  nlohmann::json summary = Summary();
+  summary.update(extra);
+  std::string text = "{\"summary\": " + summary.dump(1) + ",\n\"frames\": [\n";
+  for (std::size_t i = 0; i < frame_json_.size(); ++i) {
+    text += frame_json_[i];
+    text += i + 1 < frame_json_.size() ? ",\n" : "\n";
+  }
+  text += "]}\n";
+  WriteFileAtomically(path, text);
+}
+
+}  // namespace ihs::app

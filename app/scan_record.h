@@ -1,0 +1,56 @@
+#pragma once
+// What a scan keeps besides the model: per-frame statistics (status, reason, stage timings), the
+// object's trajectory, the hand's joints and poses; and the files they go to. Owned by whoever
+// runs the last stage (the fusion thread); copies are snapshots for an export in mid-scan.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "app/scan_stages.h"
+#include "core/trajectory_io.h"
+#include "tracker/hand_joints_io.h"
+
+namespace ihs::app {
+
+/// Per-frame log of a scan.
+class ScanRecord {
+ public:
+  /// `bone_names` name the joints' columns in hand_joints.csv.
+  explicit ScanRecord(std::vector<std::string> bone_names = {});
+
+  /// Records a frame both stages have processed.
+  void Add(const FramePacket& packet);
+  /// Frames recorded (processed, not dropped).
+  std::int64_t frames() const { return frames_; }
+  /// Frames registered into the model.
+  std::int64_t registered() const { return static_cast<std::int64_t>(trajectory_.size()); }
+  /// Frames skipped by the fusion stage, by the reason's kind.
+  const std::map<std::string, std::int64_t>& skip_reasons() const { return skip_reasons_; }
+  /// The object's pose in each registered frame (cam_from_object, mm).
+  const std::vector<StampedPose>& trajectory() const { return trajectory_; }
+
+  /// Totals: counts by status and reason, mean ms per stage, latency percentiles.
+  nlohmann::json Summary() const;
+
+  /// Writes trajectory.txt, hand_joints.csv and hand_poses.csv into `folder`.
+  void WriteTables(const std::filesystem::path& folder) const;
+  /// Writes `path` as {"summary": Summary() merged with `extra`, "frames": [...]}.
+  void WriteStats(const std::filesystem::path& path, const nlohmann::json& extra) const;
+
+ private:
+  std::vector<std::string> bone_names_;
+  std::int64_t frames_ = 0;
+  std::vector<std::string> frame_json_;  // One serialised object per recorded frame.
+  std::map<std::string, std::int64_t> track_counts_, fusion_counts_, skip_reasons_;
+  std::map<std::string, std::pair<double, std::int64_t>> stage_ms_;  // Sum and count.
+  std::vector<double> latencies_ms_;
+  std::vector<StampedPose> trajectory_;
+  std::vector<tracker::HandJointsRow> joints_;
+  std::vector<std::string> pose_rows_;  // hand_poses.csv lines.
+};
+
+}  // namespace ihs::app

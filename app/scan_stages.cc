@@ -1,0 +1,126 @@
+#include "app/scan_stages.h"
+
+#include <exception>
+
+#include "core/errors.h"
+#include "core/stopwatch.h"
+#include "fusion/object_mask.h"
+#include "fusion/shot_matcher.h"
+#include "fusion/sift_matcher.h"
+#include "tracker/hand_data.h"
+#include "tracker/hand_kinematics.h"
+#include "tracker/procedural_hand.h"
+
+namespace ihs::app {
+namespace {
+
+// The tracker's options with the template's scale estimate off when the scale is given or the
+// template is a scan of the user's own hand.
+tracker::TrackerOptions TrackerOptionsFor(const ScannerOptions& options) {
+  tracker::TrackerOptions tracker_options = options.tracker;
+  if (options.scan.hand_scale > 0 || options.scan.hand_template != "procedural") {
+    tracker_options.scale_frames = 0;
+  }
+  return tracker_options;
+}
+
+const ScannerOptions& Checked(const ScannerOptions& options) {
+  options.Check();
+  return options;
+}
+
+}  // namespace
+
+tracker::HandModel LoadHandTemplate(const ScanOptions& options) {
+  tracker::HandModel model = options.hand_template == "procedural"
+                                 ? tracker::MakeProceduralHand()
+                                 : tracker::LoadHandModel(options.hand_template);
+  if (options.hand_scale > 0) model = model.Scaled(options.hand_scale);
+  return model;
+}
+
+HandStage::HandStage(const ScannerOptions& options, const CameraIntrinsics& intrinsics)
+    : options_(Checked(options).scan),
+      intrinsics_(intrinsics),
+      tracker_(LoadHandTemplate(options.scan), intrinsics, TrackerOptionsFor(options)) {}
+
+HandStage::~HandStage() = default;
+
+void HandStage::Initialise(const tracker::HandPose& pose) { tracker_.Initialise(pose); }
+
+double HandStage::scale() const {
+  return tracker_.scale() * (options_.hand_scale > 0 ? options_.hand_scale : 1.0);
+}
+
+std::vector<std::string> HandStage::BoneNames() const {
+  std::vector<std::string> names;
+  for (const auto& bone : tracker_.model().bones) names.push_back(bone.name);
+  return names;
+}
+
+void HandStage::Process(FramePacket& packet) {
+  if (!packet.frame) throw InternalError("HandStage: a packet without a frame");
+  const Frame& frame = *packet.frame;
+  try {
+    frame.Check();
+  } catch (const InputError& error) {
+    packet.frame_error = error.what();
+    return;
+  }
+  packet.track = tracker_.Track(frame);
+  const auto start = SteadyClock::now();
+  packet.object_mask = packet.track.segmentation.object_mask;
+  if (packet.object_mask.size() != frame.depth_mm.size()) {
+    packet.object_mask.assign(frame.depth_mm.size(), 0);
+  }
+  if (packet.track.HasPose()) {
+    auto hand = std::make_shared<TriangleMesh>(
+        tracker_.model().Pose(tracker::ForwardKinematics(tracker_.model(), packet.track.pose)));
+    packet.hand_pixels_removed =
+        fusion::RemoveMeshPixels(*hand, frame, intrinsics_, options_.hand_dilation_px,
+                                 options_.hand_depth_margin_mm, &packet.object_mask);
+    packet.hand_mesh = std::move(hand);
+  }
+  packet.mask_ms = MillisecondsSince(start);
+}
+
+ObjectStage::ObjectStage(const ScannerOptions& options, const CameraIntrinsics& intrinsics)
+    : options_(Checked(options).scan),
+      sift_(std::make_unique<fusion::SiftMatcher>(intrinsics, options.sift)),
+      shot_(std::make_unique<fusion::ShotMatcher>(intrinsics, options.shot)),
+      fusion_(intrinsics, options.fusion) {}
+
+ObjectStage::~ObjectStage() = default;
+
+void ObjectStage::Process(FramePacket& packet) {
+  if (!packet.frame_error.empty()) {
+    packet.fusion = {};
+    packet.fusion.status = fusion::FusionStatus::kSkipped;
+    packet.fusion.reason = "malformed frame: " + packet.frame_error;
+    return;
+  }
+  const Frame& frame = *packet.frame;
+  fusion::FusionInput input;
+  input.frame = &frame;
+  input.object_mask = &packet.object_mask;
+  const auto start = SteadyClock::now();
+  if (options_.features_2d) {
+    input.correspondences.features_2d = sift_->Match(frame, packet.object_mask);
+  }
+  if (options_.features_3d) {
+    input.correspondences.features_3d = shot_->Match(frame, packet.object_mask);
+  }
+  packet.features_ms = MillisecondsSince(start);
+  for (const auto& pair : packet.track.contact_pairs) {
+    input.correspondences.contacts.push_back({pair.previous_mm, pair.current_mm});
+    input.contact_ids.push_back(pair.vertex);
+  }
+  packet.sift_matches = static_cast<int>(input.correspondences.features_2d.size());
+  packet.shot_matches = static_cast<int>(input.correspondences.features_3d.size());
+  packet.contact_pairs = static_cast<int>(input.correspondences.contacts.size());
+  packet.fusion = fusion_.Fuse(input);
+}
+
+TriangleMesh ObjectStage::Snapshot() const { return fusion_.ExtractMesh(); }
+
+}  // namespace ihs::app

@@ -1,0 +1,111 @@
+#pragma once
+// The scanner's two per-frame stages as the pipeline's threads run them, and the packet that
+// carries a frame through them. HandStage: hand tracker, then the object's pixels without the
+// posed hand model. ObjectStage: SIFT (and optionally ISS3D + CSHOT) matches with the previous
+// frame plus the tracker's contact pairs, then registration, ICP and TSDF integration. Stage
+// objects know nothing of threads; inhandscan-scan runs them one after the other, the Pipeline
+// each on its own thread.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/scanner_options.h"
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "core/triangle_mesh.h"
+#include "fusion/object_fusion.h"
+#include "tracker/hand_tracker.h"
+
+namespace ihs::fusion {
+class SiftMatcher;
+class ShotMatcher;
+}  // namespace ihs::fusion
+
+namespace ihs::app {
+
+/// One frame and what the stages found in it; it grows as it moves down the pipeline.
+struct FramePacket {
+  /// The frame, immutable after capture.
+  std::shared_ptr<const Frame> frame;
+  /// When the capture thread got it (for latency).
+  std::chrono::steady_clock::time_point captured_at;
+  /// Non-empty when the frame is malformed (wrong image sizes): no stage touches it.
+  std::string frame_error;
+
+  // Filled by HandStage.
+  tracker::TrackResult track;
+  /// The posed hand model (camera frame, mm) when the tracker has a pose.
+  std::shared_ptr<const TriangleMesh> hand_mesh;
+  /// Per pixel: non-zero where the object is, the hand model's pixels (dilated) removed.
+  std::vector<std::uint8_t> object_mask;
+  int hand_pixels_removed = 0;
+  double mask_ms = 0;
+
+  // Filled by ObjectStage.
+  fusion::FusionResult fusion;
+  int sift_matches = 0;
+  int shot_matches = 0;
+  int contact_pairs = 0;
+  double features_ms = 0;
+  /// From capture to fused, ms (set by whoever runs the stages).
+  double latency_ms = 0;
+
+  /// Whether the frame was registered (started or fused).
+  bool Registered() const { return fusion.status != fusion::FusionStatus::kSkipped; }
+};
+
+/// The hand template `options` names, at its given scale (procedural or a scanned model).
+/// Throws ihs::InputError when a scanned model cannot be read.
+tracker::HandModel LoadHandTemplate(const ScanOptions& options);
+
+/// Hand tracking and the hand-free object mask.
+class HandStage {
+ public:
+  /// Throws std::invalid_argument for bad options, ihs::InputError for an unreadable template.
+  HandStage(const ScannerOptions& options, const CameraIntrinsics& intrinsics);
+  ~HandStage();
+
+  /// Starts the tracker from a known pose (benchmark mode) instead of the hand cloud.
+  void Initialise(const tracker::HandPose& pose);
+  /// Fills the packet's hand fields.
+  void Process(FramePacket& packet);
+
+  /// The template at its current scale.
+  const tracker::HandModel& model() const { return tracker_.model(); }
+  /// The template's scale relative to the one loaded (estimated or given).
+  double scale() const;
+  /// Names of the template's bones (the joints' columns).
+  std::vector<std::string> BoneNames() const;
+
+ private:
+  const ScanOptions options_;
+  const CameraIntrinsics intrinsics_;
+  tracker::HandTracker tracker_;
+};
+
+/// Correspondences, registration, ICP and the TSDF: the model belongs to this stage.
+class ObjectStage {
+ public:
+  ObjectStage(const ScannerOptions& options, const CameraIntrinsics& intrinsics);
+  ~ObjectStage();
+
+  /// Fills the packet's fusion fields (a malformed frame is skipped with its reason).
+  void Process(FramePacket& packet);
+  /// The raw marching-cubes mesh of the model so far (object frame, mm): an immutable copy.
+  TriangleMesh Snapshot() const;
+  /// Whether the model has been started (a first frame fused).
+  bool started() const { return fusion_.started(); }
+  /// The model (for a raycast view); only the owning thread may read it.
+  const fusion::TsdfVolume& volume() const { return fusion_.volume(); }
+
+ private:
+  const ScanOptions options_;
+  std::unique_ptr<fusion::SiftMatcher> sift_;
+  std::unique_ptr<fusion::ShotMatcher> shot_;
+  fusion::ObjectFusion fusion_;
+};
+
+}  // namespace ihs::app

@@ -1,0 +1,72 @@
+#pragma once
+// All the scanner's options in one struct: the tracker's, the fusion's, the meshing's and the
+// application's own. `app` fills it from a config file and the command line (see
+// RegisterScannerOptions) and hands the sub-structs to the stages; nothing changes it after the
+// pipeline starts.
+
+#include <string>
+
+#include "app/option_registry.h"
+#include "fusion/object_fusion.h"
+#include "fusion/shot_matcher.h"
+#include "fusion/sift_matcher.h"
+#include "fusion/surface_mesh.h"
+#include "tracker/hand_tracker.h"
+
+namespace ihs::app {
+
+/// Which correspondences the pairwise registration uses and what else a scan does beyond the
+/// stages' own options.
+struct ScanOptions {
+  /// Hand template: "procedural", or a folder with the real hand model (../shared/data/...).
+  std::string hand_template = "procedural";
+  /// Scale of the template (0: the procedural template's is estimated over the first frames, a
+  /// scanned template is used at 1).
+  double hand_scale = 0.0;
+  /// Pixels around the posed hand model that are never the object's (the paper: "dilated a few
+  /// pixels").
+  int hand_dilation_px = 4;
+  /// The posed hand model removes object pixels up to this far behind the observed depth, mm.
+  double hand_depth_margin_mm = 10.0;
+  /// SIFT matches on the object's colour (E_feat2d; off: contacts and ICP only).
+  bool features_2d = true;
+  /// ISS3D + CSHOT matches on the object's points (E_feat3d; off by default: about 200 ms per
+  /// frame, and misleading on symmetric objects).
+  bool features_3d = false;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Options of the threaded pipeline.
+struct PipelineOptions {
+  /// Frames each queue between two threads holds.
+  int queue_capacity = 4;
+  /// Write a preview image every this many fused frames (0: never).
+  int preview_every = 30;
+  /// Frames the capture thread reads at most (0: all).
+  int max_frames = 0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Every option of the scanner.
+struct ScannerOptions {
+  ScanOptions scan;
+  tracker::TrackerOptions tracker;
+  fusion::SiftOptions sift;
+  fusion::ShotOptions shot;
+  fusion::FusionOptions fusion;
+  fusion::MeshingOptions meshing;
+  PipelineOptions pipeline;
+
+  /// Checks every sub-struct; throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// Registers every field of `options` under its dotted name ("fusion.icp.max_distance_mm") with
+/// one line of meaning. The registry points into `options`, which must outlive it.
+OptionRegistry RegisterScannerOptions(ScannerOptions* options);
+
+}  // namespace ihs::app

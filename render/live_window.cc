@@ -1,0 +1,140 @@
+#include "render/live_window.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GL/gl.h>
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <mutex>
+
+#include "core/errors.h"
+
+namespace ihs::render {
+namespace {
+
+std::mutex error_mutex;
+std::string last_glfw_error;
+
+void RememberError(int code, const char* description) {
+  std::lock_guard<std::mutex> lock(error_mutex);
+  last_glfw_error = description ? description : "unknown GLFW error";
+}
+
+std::string TakeError() {
+  std::lock_guard<std::mutex> lock(error_mutex);
+  return last_glfw_error.empty() ? "unknown reason" : last_glfw_error;
+}
+
+}  // namespace
+
+// The OpenGL functions the window uses, from the window's own context (glfwGetProcAddress):
+// this library also links OSMesa, whose gl* symbols the off-screen renderer calls, so the
+// window must not call gl* by name.
+struct GlFunctions {
+  void (*Viewport)(GLint, GLint, GLsizei, GLsizei) = nullptr;
+  void (*ClearColor)(GLfloat, GLfloat, GLfloat, GLfloat) = nullptr;
+  void (*Clear)(GLbitfield) = nullptr;
+  void (*MatrixMode)(GLenum) = nullptr;
+  void (*LoadIdentity)() = nullptr;
+  void (*RasterPos2f)(GLfloat, GLfloat) = nullptr;
+  void (*PixelZoom)(GLfloat, GLfloat) = nullptr;
+  void (*PixelStorei)(GLenum, GLint) = nullptr;
+  void (*DrawPixels)(GLsizei, GLsizei, GLenum, GLenum, const void*) = nullptr;
+
+  template <typename F>
+  static void Load(F*& function, const char* name) {
+    function = reinterpret_cast<F*>(glfwGetProcAddress(name));
+    if (!function) throw DeviceError(std::string("cannot open a window: OpenGL lacks ") + name);
+  }
+  void LoadAll() {
+    Load(Viewport, "glViewport");
+    Load(ClearColor, "glClearColor");
+    Load(Clear, "glClear");
+    Load(MatrixMode, "glMatrixMode");
+    Load(LoadIdentity, "glLoadIdentity");
+    Load(RasterPos2f, "glRasterPos2f");
+    Load(PixelZoom, "glPixelZoom");
+    Load(PixelStorei, "glPixelStorei");
+    Load(DrawPixels, "glDrawPixels");
+  }
+};
+
+struct LiveWindow::State {
+  GLFWwindow* window = nullptr;
+  GlFunctions gl;
+  std::vector<char> keys;
+};
+
+LiveWindow::LiveWindow(const std::string& title, int width, int height)
+    : state_(std::make_unique<State>()) {
+  glfwSetErrorCallback(RememberError);
+  if (!glfwInit()) throw DeviceError("cannot open a window: " + TakeError());
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_TRUE);
+  state_->window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (!state_->window) {
+    const std::string error = TakeError();
+    glfwTerminate();
+    throw DeviceError("cannot open a window: " + error);
+  }
+  glfwMakeContextCurrent(state_->window);
+  try {
+    state_->gl.LoadAll();
+  } catch (...) {
+    glfwDestroyWindow(state_->window);
+    glfwTerminate();
+    throw;
+  }
+  glfwSwapInterval(0);
+  glfwSetWindowUserPointer(state_->window, state_.get());
+  glfwSetKeyCallback(state_->window, [](GLFWwindow* window, int key, int, int action, int) {
+    if (action != GLFW_PRESS) return;
+    auto* state = static_cast<State*>(glfwGetWindowUserPointer(window));
+    if (key == GLFW_KEY_ESCAPE) {
+      state->keys.push_back('q');
+    } else if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) {
+      state->keys.push_back(static_cast<char>('a' + (key - GLFW_KEY_A)));
+    }
+  });
+}
+
+LiveWindow::~LiveWindow() {
+  if (state_->window) glfwDestroyWindow(state_->window);
+  glfwTerminate();
+}
+
+void LiveWindow::Show(const std::vector<std::uint8_t>& rgb, int width, int height) {
+  if (width <= 0 || height <= 0 || rgb.size() < static_cast<std::size_t>(width) * height * 3) {
+    return;
+  }
+  glfwMakeContextCurrent(state_->window);
+  const GlFunctions& gl = state_->gl;
+  int window_width = 0, window_height = 0;
+  glfwGetFramebufferSize(state_->window, &window_width, &window_height);
+  gl.Viewport(0, 0, window_width, window_height);
+  gl.ClearColor(0.1f, 0.1f, 0.12f, 1.0f);
+  gl.Clear(GL_COLOR_BUFFER_BIT);
+  // Images are stored top row first; OpenGL draws bottom-up: start at the top-left corner and
+  // zoom by a negative factor vertically.
+  const float zoom = std::min(static_cast<float>(window_width) / width,
+                              static_cast<float>(window_height) / height);
+  gl.MatrixMode(GL_PROJECTION);
+  gl.LoadIdentity();
+  gl.MatrixMode(GL_MODELVIEW);
+  gl.LoadIdentity();
+  gl.RasterPos2f(-1.0f, 1.0f);
+  gl.PixelZoom(zoom, -zoom);
+  gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  gl.DrawPixels(width, height, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
+  glfwSwapBuffers(state_->window);
+}
+
+std::vector<char> LiveWindow::PollKeys() {
+  glfwPollEvents();
+  std::vector<char> keys;
+  keys.swap(state_->keys);
+  return keys;
+}
+
+bool LiveWindow::ShouldClose() const { return glfwWindowShouldClose(state_->window); }
+
+}  // namespace ihs::render

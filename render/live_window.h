@@ -1,0 +1,36 @@
+#pragma once
+// The live window (GLFW): shows an RGB image the application composes and reports key presses.
+// GLFW's headers stay in the .cc file. Must be created, used and destroyed on one thread (the
+// process's main thread, as GLFW requires).
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace ihs::render {
+
+/// A window that displays RGB8 images.
+class LiveWindow {
+ public:
+  /// Opens a window of `width`×`height` pixels. Throws ihs::DeviceError (with GLFW's reason, e.g.
+  /// no display) when it cannot.
+  LiveWindow(const std::string& title, int width, int height);
+  ~LiveWindow();
+  LiveWindow(const LiveWindow&) = delete;
+  LiveWindow& operator=(const LiveWindow&) = delete;
+
+  /// Draws `rgb` (width·height·3 bytes, row-major from the top-left pixel), scaled to the window.
+  void Show(const std::vector<std::uint8_t>& rgb, int width, int height);
+  /// Processes window events; returns the keys pressed since the last call as lower-case ASCII
+  /// characters ('s', 'r', 'q', …; Escape is reported as 'q').
+  std::vector<char> PollKeys();
+  /// Whether the user closed the window.
+  bool ShouldClose() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace ihs::render
