@@ -66,6 +66,9 @@ class FrameSource {
   virtual bool IsLive() const = 0;
   /// Frames the source could not decode and skipped (each also logged with its reason).
   virtual std::int64_t SkippedFrames() const { return 0; }
+  /// Frames the device (or a player pacing a recording like one) produced but that never
+  /// reached this reader: gaps in the device's own frame numbers.
+  virtual std::int64_t MissedFrames() const { return 0; }
   /// Whether the frames come from a damaged recording that was only partly recovered.
   virtual bool Recovered() const { return false; }
 };

@@ -59,6 +59,7 @@ class AutoOniSource : public FrameSource {
   }
   bool IsLive() const override { return pacing_ == Pacing::kRealTime; }
   std::int64_t SkippedFrames() const override { return active_ ? active_->SkippedFrames() : 0; }
+  std::int64_t MissedFrames() const override { return active_ ? active_->MissedFrames() : 0; }
   bool Recovered() const override { return active_ && active_->Recovered(); }
 
  private:

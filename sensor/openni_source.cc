@@ -96,6 +96,11 @@ struct OpenNiSource::Impl : public openni::OpenNI::DeviceDisconnectedListener {
   std::int64_t depth_frames_read = 0;
   std::int64_t delivered = 0;
   std::int64_t without_color = 0;
+  // The live device's number of the last depth frame read, and the gaps seen; whether a
+  // recording has ended.
+  bool ended = false;
+  std::int64_t last_device_index = -1;
+  std::int64_t missed = 0;
   std::atomic<bool> disconnected{false};
   // Colour frames seen and not yet used, oldest first (a few at most).
   std::deque<std::shared_ptr<const Frame>> colors;
@@ -372,11 +377,13 @@ SourceRead OpenNiSource::Next(std::chrono::milliseconds timeout) {
     if (status != openni::STATUS_OK) {
       if (depth_exhausted) {
         if (s.held_depth) return deliver();
+        s.ended = true;
         return {SourceStatus::kEndOfStream, nullptr, "end of " + options_.uri};
       }
       if (status == openni::STATUS_TIME_OUT) {
         if (s.is_file && std::chrono::steady_clock::now() - s.last_activity > kRecordingSilence) {
           if (s.held_depth) return deliver();
+          s.ended = true;
           return {SourceStatus::kEndOfStream, nullptr,
                   "end of " + options_.uri + ": the player stopped delivering frames after " +
                       std::to_string(s.depth_frames_read) + " (damaged or unfinished recording?)"};
@@ -388,6 +395,7 @@ SourceRead OpenNiSource::Next(std::chrono::milliseconds timeout) {
         return {SourceStatus::kDisconnected, nullptr,
                 s.description + " stopped delivering frames: " + ExtendedError()};
       }
+      s.ended = true;
       return {SourceStatus::kEndOfStream, nullptr,
               "end of " + options_.uri + ": " + ExtendedError()};
     }
@@ -408,6 +416,11 @@ SourceRead OpenNiSource::Next(std::chrono::milliseconds timeout) {
       continue;
     }
     ++s.depth_frames_read;
+    const std::int64_t device_index = ref.getFrameIndex();
+    if (!s.is_file && s.last_device_index >= 0 && device_index > s.last_device_index + 1) {
+      s.missed += device_index - s.last_device_index - 1;
+    }
+    s.last_device_index = device_index;
     std::shared_ptr<Frame> depth = ToDepthFrame(ref);
     if (s.held_depth) {
       // A newer depth frame came first: the held one gets the best colour seen so far.
@@ -441,6 +454,18 @@ std::vector<openni::VideoStream*> OpenNiSource::OpenNiStreams() {
   std::vector<openni::VideoStream*> streams = {&impl_->depth};
   if (impl_->has_color) streams.push_back(&impl_->color);
   return streams;
+}
+
+std::int64_t OpenNiSource::MissedFrames() const {
+  if (!impl_) return 0;
+  // A recording played at its pace: what the player had but we never read, once it has ended
+  // (its frame numbers are not consecutive per stream, so gaps in them do not tell).
+  if (impl_->is_file) {
+    return impl_->ended && impl_->depth_frame_count >= 0
+               ? std::max<std::int64_t>(0, impl_->depth_frame_count - impl_->depth_frames_read)
+               : 0;
+  }
+  return impl_->missed;
 }
 
 std::int64_t OpenNiSource::FramesWithoutColor() const { return impl_ ? impl_->without_color : 0; }

@@ -59,6 +59,7 @@ class OpenNiSource : public FrameSource {
   std::string Description() const override;
   std::optional<std::int64_t> FrameCount() const override;
   bool IsLive() const override;
+  std::int64_t MissedFrames() const override;
 
   /// Depth frames delivered without colour (no colour frame close enough in time).
   std::int64_t FramesWithoutColor() const;

@@ -24,6 +24,8 @@ class PacedSource : public FrameSource {
   std::optional<std::int64_t> FrameCount() const override { return inner_->FrameCount(); }
   /// Paced recordings behave like live devices: a slow consumer must drop frames.
   bool IsLive() const override { return true; }
+  std::int64_t MissedFrames() const override { return inner_->MissedFrames(); }
+  std::int64_t SkippedFrames() const override { return inner_->SkippedFrames(); }
 
  private:
   std::unique_ptr<FrameSource> inner_;

@@ -74,7 +74,10 @@ SourceRead ReplaySource::Next(std::chrono::milliseconds timeout) {
       frame.color_timestamp_us = previous_->color_timestamp_us;
     }
     previous_ = frame;
-    if (dropped) continue;
+    if (dropped) {
+      ++missed_;
+      continue;
+    }
     if (faults_.all_zero.count(index)) std::fill(frame.depth_mm.begin(), frame.depth_mm.end(), 0);
     if (faults_.wrong_size.count(index)) frame.depth_mm.resize(frame.depth_mm.size() / 2);
 

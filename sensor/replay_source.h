@@ -50,6 +50,10 @@ class ReplaySource : public FrameSource {
   std::string Description() const override;
   std::optional<std::int64_t> FrameCount() const override;
   bool IsLive() const override { return live_; }
+  /// Frames dropped by the fault plan, plus those the underlying source missed.
+  std::int64_t MissedFrames() const override {
+    return missed_ + (inner_ ? inner_->MissedFrames() : 0);
+  }
 
  private:
   // The next frame of the underlying stream, before faults.
@@ -62,6 +66,7 @@ class ReplaySource : public FrameSource {
   const bool live_;
   bool started_ = false;
   std::int64_t next_index_ = 0;  // Index of the next underlying frame.
+  std::int64_t missed_ = 0;      // Frames dropped by the fault plan.
   std::optional<Frame> previous_;
   // A frame held back by a stall, and when it may be delivered.
   std::shared_ptr<const Frame> stalled_;

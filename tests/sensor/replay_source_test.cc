@@ -40,6 +40,7 @@ TEST(ReplaySourceTest, InjectsDropsDuplicatesAndCorruptFrames) {
   std::vector<std::int64_t> indices;
   for (const auto& frame : frames) indices.push_back(frame->index);
   EXPECT_EQ(indices, (std::vector<std::int64_t>{0, 2, 4, 5, 6, 7}));
+  EXPECT_EQ(source.MissedFrames(), 2);  // The dropped ones, as a sensor would report them.
   EXPECT_EQ(frames[2]->depth_timestamp_us, test::MakePatternFrame(3).depth_timestamp_us);
   EXPECT_THROW(frames[3]->Check(), InputError);
   EXPECT_EQ(frames[4]->ValidDepthCount(), 0);

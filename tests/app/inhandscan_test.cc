@@ -1,0 +1,144 @@
+// The inhandscan executable as a user drives it: help and exit codes, options and config files,
+// a missing input or device, and signals during a replay (SIGUSR1 exports and the scan goes on;
+// SIGINT finishes, exports and exits 0).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "core/mesh_io.h"
+#include "tests/test_util.h"
+#include "tools/synth/sequence.h"
+
+namespace ihs {
+namespace {
+
+namespace fs = std::filesystem;
+
+test::CommandResult RunApp(const std::string& arguments) {
+  return test::RunCommand(std::string(IHS_APP) + " " + arguments);
+}
+
+int Lines(const std::string& text) {
+  return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+}
+
+TEST(InhandscanTest, HelpListsTheSubcommandsAndExitCodes) {
+  const auto help = RunApp("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* word : {"live", "replay", "record", "devices", "config", "--config", "--set"}) {
+    EXPECT_NE(help.out.find(word), std::string::npos) << word;
+  }
+  EXPECT_NE(help.out.find("5"), std::string::npos);
+  EXPECT_NE(help.out.find("partial"), std::string::npos) << help.out;
+  const auto version = RunApp("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.out.find(IHS_VERSION), std::string::npos);
+}
+
+TEST(InhandscanTest, ConfigPrintsEveryOptionAsAFileItReadsBack) {
+  test::TempDir dir;
+  const auto config = RunApp("config --set fusion.pairwise.contact_weight=5");
+  ASSERT_EQ(config.exit_code, 0) << config.err;
+  EXPECT_NE(config.out.find("fusion.pairwise.contact_weight = 5\n"), std::string::npos);
+  EXPECT_NE(config.out.find("tracker.fit.collision_weight = 10\n"), std::string::npos);
+  EXPECT_NE(config.out.find("# gamma_t"), std::string::npos);
+  test::WriteBytes(dir / "scan.conf", config.out);
+  const auto reread = RunApp("config --config " + (dir / "scan.conf").string());
+  ASSERT_EQ(reread.exit_code, 0) << reread.err;
+  EXPECT_EQ(reread.out, config.out);
+}
+
+TEST(InhandscanTest, BadUsageGetsOneLineAndCodeTwo) {
+  for (const char* arguments :
+       {"", "replay", "frobnicate", "config --set fusion.nonsense=1",
+        "config --set fusion.tsdf.resolution=many", "config --set pipeline.queue_capacity=0",
+        "replay x.oni --format gif", "config --config /nonexistent/inhandscan.conf"}) {
+    const auto run = RunApp(arguments);
+    const int expected = std::string(arguments).find("nonexistent") != std::string::npos ? 3 : 2;
+    EXPECT_EQ(run.exit_code, expected) << arguments << ": " << run.err;
+    EXPECT_EQ(Lines(run.err), 1) << arguments << ": " << run.err;
+  }
+}
+
+TEST(InhandscanTest, AMissingRecordingIsCodeThree) {
+  test::TempDir dir;
+  const auto run =
+      RunApp("replay " + (dir / "missing.oni").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_EQ(Lines(run.err), 1) << run.err;
+  EXPECT_NE(run.err.find("missing.oni"), std::string::npos);
+}
+
+TEST(InhandscanTest, LiveWithoutACameraSaysSoWithCodeFour) {
+  test::TempDir dir;
+  const auto run = RunApp("live --no-window --out " + (dir / "out").string());
+  if (run.exit_code == 0) GTEST_SKIP() << "a camera is attached";
+  EXPECT_EQ(run.exit_code, 4) << run.err;
+  EXPECT_NE(run.err.find("camera"), std::string::npos) << run.err;
+  const auto devices = RunApp("devices");
+  EXPECT_EQ(devices.exit_code, 4) << devices.err;
+  EXPECT_NE(devices.out.find("OpenNI2"), std::string::npos) << devices.out;
+}
+
+class InhandscanSignalTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir();
+    synth::SequenceOptions options;  // 90 frames: 3 s at the recorded pace.
+    options.scripted.frames = 90;
+    options.write_tum = false;
+    synth::GenerateSequence(options, dir_->path());
+  }
+  static void TearDownTestSuite() { delete dir_; }
+
+  // Replays at the recorded pace, sends `signal` after `seconds`, and waits for the exit.
+  static test::CommandResult ReplayWithSignal(const fs::path& out, const std::string& signal,
+                                              double seconds) {
+    const std::string command = std::string(IHS_APP) + " replay --realtime " +
+                                (*dir_ / "sequence.oni").string() + " --out " + out.string() +
+                                " --set pipeline.preview_every=0 & pid=$!; sleep " +
+                                std::to_string(seconds) + "; kill -" + signal + " $pid; wait $pid";
+    return test::RunCommand("sh -c '" + command + "'");
+  }
+
+  static test::TempDir* dir_;
+};
+
+test::TempDir* InhandscanSignalTest::dir_ = nullptr;
+
+TEST_F(InhandscanSignalTest, SigusrOneExportsAndTheReplayGoesOn) {
+  test::TempDir out;
+  const auto run = ReplayWithSignal(out.path(), "USR1", 1.5);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("export requested"), std::string::npos) << run.err;
+  // The requested export and the final one.
+  size_t exports = 0;
+  for (size_t at = run.err.find("exported "); at != std::string::npos;
+       at = run.err.find("exported ", at + 1)) {
+    ++exports;
+  }
+  EXPECT_EQ(exports, 2u) << run.err;
+  const auto stats = nlohmann::json::parse(test::ReadFileString(out / "stats.json"));
+  EXPECT_EQ(stats["summary"]["end_reason"], "end of stream");
+  // At the recorded pace OpenNI2's player may skip a frame the reader was late for: counted.
+  EXPECT_EQ(stats["summary"]["captured_frames"].get<int>() +
+                stats["summary"]["dropped_frames"]["missed_by_source"].get<int>(),
+            90);
+  EXPECT_TRUE(ReadMesh(out / "mesh.ply").IsWatertight());
+}
+
+TEST_F(InhandscanSignalTest, SigintFinishesExportsAndExitsZero) {
+  test::TempDir out;
+  const auto run = ReplayWithSignal(out.path(), "INT", 1.5);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("mesh: "), std::string::npos) << run.out;
+  const auto stats = nlohmann::json::parse(test::ReadFileString(out / "stats.json"));
+  EXPECT_EQ(stats["summary"]["end_reason"], "stopped");
+  EXPECT_LT(stats["summary"]["captured_frames"].get<int>(), 90);
+  EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
+}
+
+}  // namespace
+}  // namespace ihs
