@@ -32,8 +32,11 @@ RgbImage ComposeLiveScreen(const LiveView& view, const CameraIntrinsics& intrins
     if (contact.z() > 0) cv::circle(left, project(contact), 2, cv::Scalar(255, 40, 40), -1);
   }
   if (view.model.width == width && view.model.height == height) {
-    cv::Mat(height, width, CV_8UC3, const_cast<std::uint8_t*>(view.model.rgb.data()))
-        .copyTo(screen(cv::Rect(width, 0, width, height)));
+    // The model where the raycast hit it, over the window's background elsewhere.
+    cv::Mat model(height, width, CV_8UC3, const_cast<std::uint8_t*>(view.model.rgb.data()));
+    cv::Mat hit;
+    cv::cvtColor(model, hit, cv::COLOR_RGB2GRAY);
+    model.copyTo(screen(cv::Rect(width, 0, width, height)), hit > 0);
   }
   cv::putText(screen, status_line + "   keys: s save, r reset, q quit",
               cv::Point(8, height + kStatusHeight - 9), cv::FONT_HERSHEY_SIMPLEX, 0.5,

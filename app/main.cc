@@ -71,6 +71,8 @@ struct ScanArgs {
   std::string out;
   std::vector<std::string> formats;
   bool no_window = false;
+  bool window = false;
+  std::string screenshot;
   bool realtime = false;
   std::string device;
   std::string input;
@@ -131,7 +133,7 @@ class ProgressReporter {
 // Runs a pipeline to its end: signals (and the window's keys) become requests; returns the
 // exit code after printing where the mesh is.
 int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
-                ihs::render::LiveWindow* window, bool quiet) {
+                ihs::render::LiveWindow* window, const std::string& screenshot, bool quiet) {
   ProgressReporter reporter;
   bool stop_sent = false;
   while (!pipeline.Wait(std::chrono::milliseconds(window ? 15 : 100))) {
@@ -162,6 +164,17 @@ int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
     }
   }
   reporter.Done();
+  if (window && !screenshot.empty()) {
+    if (auto view = pipeline.TakeLiveView()) {  // The last frames' view, not yet shown.
+      const ihs::app::RgbImage screen =
+          ihs::app::ComposeLiveScreen(*view, intrinsics, StatusLine(pipeline.Progress()));
+      window->Show(screen.rgb, screen.width, screen.height);
+    }
+    ihs::app::RgbImage image;
+    image.rgb = window->Screenshot(&image.width, &image.height);
+    ihs::app::WritePng(screenshot, image);
+    spdlog::info("window screenshot: {}", screenshot);
+  }
   const ihs::app::PipelineResult result = pipeline.Finish();
   const auto& p = result.progress;
   spdlog::info("{} frames ({}): {} fused, {} dropped, {:.1f} frames/s, {:.1f} s in all",
@@ -193,7 +206,7 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   }
   spdlog::info("scanning into {} (export now: kill -USR1 {}; stop: Ctrl-C)", output.folder.string(),
                getpid());
-  return RunPipeline(pipeline, pipeline.intrinsics(), window.get(), quiet);
+  return RunPipeline(pipeline, pipeline.intrinsics(), window.get(), args.screenshot, quiet);
 }
 
 }  // namespace
@@ -220,6 +233,8 @@ int main(int argc, char** argv) {
 
   ScanArgs args;
   auto add_output = [&](CLI::App* command) {
+    command->add_option("--screenshot", args.screenshot,
+                        "save a PNG of the window as it looks when the scan ends");
     command->add_option("--out", args.out, "output folder (default: scan-DATE-TIME)");
     command->add_option("--format", args.formats, "also write the mesh as obj and/or stl")
         ->check(CLI::IsMember({"obj", "stl", "ply"}))
@@ -234,6 +249,7 @@ int main(int argc, char** argv) {
   replay->add_option("input", args.input, ".oni file or TUM RGB-D folder")->required();
   replay->add_flag("--realtime", args.realtime,
                    "pace frames at their timestamps and drop frames as live would");
+  replay->add_flag("--window", args.window, "show the live window while replaying");
   add_output(replay);
   std::string record_path;
   double record_seconds = 0;
@@ -312,6 +328,7 @@ int main(int argc, char** argv) {
     ihs::sensor::InputOptions input_options;
     input_options.pacing =
         args.realtime ? ihs::sensor::Pacing::kRealTime : ihs::sensor::Pacing::kAsFastAsPossible;
-    return Scan(ihs::sensor::OpenInput(args.input, input_options), options, args, false, quiet);
+    return Scan(ihs::sensor::OpenInput(args.input, input_options), options, args, args.window,
+                quiet);
   });
 }

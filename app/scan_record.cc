@@ -74,7 +74,13 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("integrate_ms", fused.integrate_ms);
     entry["anchored_contacts"] = fused.anchored_contacts;
     entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;
-    if (fused.pairwise.ok) entry["pairwise_rms_mm"] = fused.pairwise.rms_mm;
+    if (fused.pairwise.ok) {
+      // The correspondences' motion before ICP: tx ty tz qx qy qz qw (mm), for diagnosis.
+      const Eigen::Quaterniond q = fused.pairwise.current_from_previous.quaternion();
+      const Eigen::Vector3d t = fused.pairwise.current_from_previous.translation();
+      entry["pairwise_motion"] = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+      entry["pairwise_rms_mm"] = fused.pairwise.rms_mm;
+    }
     if (fused.icp_from_previous) entry["icp_from_previous"] = true;
     if (fused.icp.iterations > 0) {
       entry["icp_inliers"] = fused.icp.inliers;

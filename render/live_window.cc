@@ -40,6 +40,9 @@ struct GlFunctions {
   void (*PixelZoom)(GLfloat, GLfloat) = nullptr;
   void (*PixelStorei)(GLenum, GLint) = nullptr;
   void (*DrawPixels)(GLsizei, GLsizei, GLenum, GLenum, const void*) = nullptr;
+  void (*ReadBuffer)(GLenum) = nullptr;
+  void (*ReadPixels)(GLint, GLint, GLsizei, GLsizei, GLenum, GLenum, void*) = nullptr;
+  void (*Finish)() = nullptr;
 
   template <typename F>
   static void Load(F*& function, const char* name) {
@@ -56,6 +59,9 @@ struct GlFunctions {
     Load(PixelZoom, "glPixelZoom");
     Load(PixelStorei, "glPixelStorei");
     Load(DrawPixels, "glDrawPixels");
+    Load(ReadBuffer, "glReadBuffer");
+    Load(ReadPixels, "glReadPixels");
+    Load(Finish, "glFinish");
   }
 };
 
@@ -63,6 +69,10 @@ struct LiveWindow::State {
   GLFWwindow* window = nullptr;
   GlFunctions gl;
   std::vector<char> keys;
+  // The image shown last, drawn again for a screenshot.
+  std::vector<std::uint8_t> shown;
+  int shown_width = 0;
+  int shown_height = 0;
 };
 
 LiveWindow::LiveWindow(const std::string& title, int width, int height)
@@ -106,6 +116,16 @@ void LiveWindow::Show(const std::vector<std::uint8_t>& rgb, int width, int heigh
   if (width <= 0 || height <= 0 || rgb.size() < static_cast<std::size_t>(width) * height * 3) {
     return;
   }
+  state_->shown = rgb;
+  state_->shown_width = width;
+  state_->shown_height = height;
+  Draw();
+  glfwSwapBuffers(state_->window);
+}
+
+void LiveWindow::Draw() {
+  const std::vector<std::uint8_t>& rgb = state_->shown;
+  const int width = state_->shown_width, height = state_->shown_height;
   glfwMakeContextCurrent(state_->window);
   const GlFunctions& gl = state_->gl;
   int window_width = 0, window_height = 0;
@@ -124,8 +144,7 @@ void LiveWindow::Show(const std::vector<std::uint8_t>& rgb, int width, int heigh
   gl.RasterPos2f(-1.0f, 1.0f);
   gl.PixelZoom(zoom, -zoom);
   gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  gl.DrawPixels(width, height, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
-  glfwSwapBuffers(state_->window);
+  if (!rgb.empty()) gl.DrawPixels(width, height, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
 }
 
 std::vector<char> LiveWindow::PollKeys() {
@@ -133,6 +152,26 @@ std::vector<char> LiveWindow::PollKeys() {
   std::vector<char> keys;
   keys.swap(state_->keys);
   return keys;
+}
+
+std::vector<std::uint8_t> LiveWindow::Screenshot(int* width, int* height) {
+  // Drawn again and read from the back buffer: the front buffer's content is not reliably
+  // readable (X servers without compositing, Xvfb).
+  Draw();
+  const GlFunctions& gl = state_->gl;
+  glfwGetFramebufferSize(state_->window, width, height);
+  std::vector<std::uint8_t> bottom_up(static_cast<std::size_t>(*width) * *height * 3);
+  gl.Finish();
+  gl.ReadBuffer(GL_BACK);
+  gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl.ReadPixels(0, 0, *width, *height, GL_RGB, GL_UNSIGNED_BYTE, bottom_up.data());
+  std::vector<std::uint8_t> rgb(bottom_up.size());
+  const std::size_t row = static_cast<std::size_t>(*width) * 3;
+  for (int v = 0; v < *height; ++v) {
+    std::copy_n(&bottom_up[(*height - 1 - v) * row], row, &rgb[v * row]);
+  }
+  glfwSwapBuffers(state_->window);
+  return rgb;
 }
 
 bool LiveWindow::ShouldClose() const { return glfwWindowShouldClose(state_->window); }

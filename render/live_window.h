@@ -25,10 +25,16 @@ class LiveWindow {
   /// Processes window events; returns the keys pressed since the last call as lower-case ASCII
   /// characters ('s', 'r', 'q', …; Escape is reported as 'q').
   std::vector<char> PollKeys();
+  /// What the window shows now, read back from its front buffer: RGB8, row-major from the
+  /// top-left pixel, `*width`×`*height` pixels.
+  std::vector<std::uint8_t> Screenshot(int* width, int* height);
   /// Whether the user closed the window.
   bool ShouldClose() const;
 
  private:
+  // Draws the image shown last into the back buffer.
+  void Draw();
+
   struct State;
   std::unique_ptr<State> state_;
 };

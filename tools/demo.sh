@@ -12,12 +12,13 @@ sample="$build_dir/demo-sample"
 echo "demo: sample sequence: $sample/sequence.oni (ground truth in $sample/gt/, a look at it:"
 echo "demo:   $sample/contact_sheet.png)"
 
-# Until the threaded application (app/inhandscan) exists, the same stages run one after the
-# other in inhandscan-scan: hand tracker → object mask → SIFT + fingertip contacts → registration,
-# ICP, TSDF → meshes. The tracker initialises itself, as it would live.
+# The application replays it headlessly on its threads (capture → hand tracker → fusion →
+# export), the tracker initialising itself as it would live.
 scan="$build_dir/demo-scan"
-"$build_dir/tools/inhandscan-scan" "$sample/sequence.oni" --out "$scan" --gt "$sample/gt" --quiet \
-  > "$scan.log"
-echo "demo: mesh: $scan/mesh.ply (watertight; the TSDF's own surface: $scan/mesh_tsdf.ply)"
-grep -E '^(diameter|volume|pairwise|surface)' "$scan.log" | sed 's/^/demo:   /'
-echo "demo: (true sphere: diameter 70 mm; all figures: $scan.log, $scan/stats.json)"
+"$build_dir/app/inhandscan" replay "$sample/sequence.oni" --out "$scan" --quiet > "$scan.log"
+echo "demo: mesh: $scan/mesh.ply (watertight; the TSDF's own surface: $scan/mesh_tsdf.ply;"
+echo "demo:   previews: $scan/preview/, statistics: $scan/stats.json)"
+"$build_dir/tools/inhandscan-measure" "$scan/mesh.ply" --object sphere --gt "$sample/gt" \
+  > "$scan.measure.log"
+grep -E '^(diameter|volume: truth)' "$scan.measure.log" | sed 's/^/demo:   /'
+echo "demo: (true sphere: diameter 70 mm; all figures: $scan.measure.log)"

@@ -47,7 +47,7 @@ SequenceRun FuseSequence(const Eigen::Vector3d& semi_axes, int contacts,
     const Frame frame = test::RenderEllipsoid(kIntrinsics, Truth(i), semi_axes);
     std::vector<std::uint8_t> mask(frame.depth_mm.size());
     for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
-    FusionInput input{&frame, &mask, {}};
+    FusionInput input{&frame, &mask, {}, {}};
     if (i > 0) {
       for (const Eigen::Vector3d& q : touched) {
         input.correspondences.contacts.push_back(
@@ -132,7 +132,7 @@ TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   ObjectFusion fusion(kIntrinsics);
   const Frame empty = Frame::Blank(640, 480, true);
   const std::vector<std::uint8_t> no_mask(empty.depth_mm.size(), 0);
-  FusionResult result = fusion.Fuse({&empty, &no_mask, {}});
+  FusionResult result = fusion.Fuse({&empty, &no_mask, {}, {}});
   EXPECT_EQ(result.status, FusionStatus::kSkipped);
   EXPECT_NE(result.reason.find("too few object points"), std::string::npos) << result.reason;
   EXPECT_FALSE(fusion.started());
@@ -140,9 +140,9 @@ TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   const Frame first = test::RenderEllipsoid(kIntrinsics, Truth(0), axes);
   std::vector<std::uint8_t> mask(first.depth_mm.size());
   for (size_t p = 0; p < mask.size(); ++p) mask[p] = first.depth_mm[p] != 0;
-  EXPECT_EQ(fusion.Fuse({&first, &mask, {}}).status, FusionStatus::kStarted);
+  EXPECT_EQ(fusion.Fuse({&first, &mask, {}, {}}).status, FusionStatus::kStarted);
   // Contacts that claim the object jumped 80 mm: not integrated.
-  FusionInput jump{&first, &mask, {}};
+  FusionInput jump{&first, &mask, {}, {}};
   for (int k = 0; k < 5; ++k) {
     const Eigen::Vector3d p = Truth(0) * Eigen::Vector3d(10.0 * k, 5.0 * k * k, 1.0 * k);
     jump.correspondences.contacts.push_back({p, p + Eigen::Vector3d(80, 0, 0)});
@@ -150,7 +150,7 @@ TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   FusionOptions no_icp;
   no_icp.use_icp = false;
   ObjectFusion contacts_only(kIntrinsics, no_icp);
-  contacts_only.Fuse({&first, &mask, {}});
+  contacts_only.Fuse({&first, &mask, {}, {}});
   result = contacts_only.Fuse(jump);
   EXPECT_EQ(result.status, FusionStatus::kSkipped);
   EXPECT_NE(result.reason.find("implausible jump"), std::string::npos) << result.reason;
