@@ -67,6 +67,13 @@ void HandStage::Process(FramePacket& packet) {
     packet.frame_error = error.what();
     return;
   }
+  if (frame.width != intrinsics_.width || frame.height != intrinsics_.height) {
+    packet.frame_error = "frame of " + std::to_string(frame.width) + "x" +
+                         std::to_string(frame.height) + " pixels from a camera of " +
+                         std::to_string(intrinsics_.width) + "x" +
+                         std::to_string(intrinsics_.height);
+    return;
+  }
   packet.track = tracker_.Track(frame);
   const auto start = SteadyClock::now();
   packet.object_mask = packet.track.segmentation.object_mask;

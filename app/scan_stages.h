@@ -32,7 +32,8 @@ struct FramePacket {
   std::shared_ptr<const Frame> frame;
   /// When the capture thread got it (for latency).
   std::chrono::steady_clock::time_point captured_at;
-  /// Non-empty when the frame is malformed (wrong image sizes): no stage touches it.
+  /// Non-empty when the frame is malformed (inconsistent image sizes, or not the camera's
+  /// size): no stage touches it.
   std::string frame_error;
 
   // Filled by HandStage.

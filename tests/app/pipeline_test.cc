@@ -115,7 +115,9 @@ class PipelineFaultTest : public PipelineTestBase {
 
 TEST_F(PipelineTest, ReplayScansTheSphereToItsSize) {
   test::TempDir out;
-  const PipelineResult result = Run(Open(Oni()), out.path());
+  // Through the replay-device shim, as the scanner's tests see a sensor.
+  const PipelineResult result =
+      Run(std::make_unique<sensor::ReplaySource>(Open(Oni()), sensor::FaultPlan{}), out.path());
   ASSERT_EQ(result.exit_code, kExitOk) << result.error;
   EXPECT_EQ(result.end_reason, "end of stream");
   EXPECT_EQ(result.progress.captured, 90);
@@ -223,6 +225,58 @@ TEST_F(PipelineFaultTest, MalformedAndEmptyFramesAreSkippedWithTheirReasons) {
   EXPECT_EQ(stats["summary"]["skip_reasons"]["malformed frame"], 2);
   EXPECT_EQ(stats["frames"][5]["fusion"], "skipped");
   EXPECT_EQ(stats["frames"][9]["fusion"], "skipped");
+  EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
+}
+
+TEST_F(PipelineFaultTest, AFrameOfAnotherSizeIsSkippedWithItsReason) {
+  auto reader = Open(Oni());
+  reader->Start();
+  std::vector<Frame> frames;
+  for (int i = 0; i < 8; ++i) frames.push_back(*reader->Next(std::chrono::seconds(5)).frame);
+  Frame small = Frame::Blank(320, 240);
+  small.index = 4;
+  frames.insert(frames.begin() + 4, small);
+  test::TempDir out;
+  const PipelineResult result = Run(
+      std::make_unique<sensor::ReplaySource>(frames, reader->Intrinsics()), out.path(), Options());
+  ASSERT_EQ(result.exit_code, kExitOk) << result.error;
+  EXPECT_EQ(result.progress.processed, 9);
+  const nlohmann::json stats = Stats(out.path());
+  EXPECT_EQ(stats["frames"][4]["track"], "malformed");
+  EXPECT_NE(stats["frames"][4]["fusion_reason"].get<std::string>().find("320x240"),
+            std::string::npos);
+  EXPECT_EQ(stats["summary"]["registered_frames"], 8);
+}
+
+// A source that hands out an empty frame pointer, as a buggy device layer might.
+class NullFrameSource : public sensor::FrameSource {
+ public:
+  explicit NullFrameSource(std::unique_ptr<sensor::FrameSource> inner) : inner_(std::move(inner)) {}
+  void Start() override { inner_->Start(); }
+  void Stop() override { inner_->Stop(); }
+  sensor::SourceRead Next(std::chrono::milliseconds timeout) override {
+    sensor::SourceRead read = inner_->Next(timeout);
+    if (++served_ == 10) read.frame = nullptr;
+    return read;
+  }
+  CameraIntrinsics Intrinsics() const override { return inner_->Intrinsics(); }
+  std::string Description() const override { return "null frames"; }
+  std::optional<std::int64_t> FrameCount() const override { return std::nullopt; }
+  bool IsLive() const override { return false; }
+
+ private:
+  std::unique_ptr<sensor::FrameSource> inner_;
+  int served_ = 0;
+};
+
+TEST_F(PipelineFaultTest, AStageThatFailsStopsThePipelineWithCodeFiveAndThePartialMesh) {
+  test::TempDir out;
+  const PipelineResult result =
+      Run(std::make_unique<NullFrameSource>(Open(Oni())), out.path(), Options());
+  EXPECT_EQ(result.exit_code, kExitStageFailed);
+  EXPECT_NE(result.error.find("tracker"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("saved"), std::string::npos) << result.error;
+  EXPECT_EQ(result.progress.processed, 9);
   EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
 }
 
