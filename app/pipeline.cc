@@ -25,32 +25,35 @@ using PacketPtr = std::unique_ptr<FramePacket>;
 // A snapshot for the export thread: a preview or a mesh export.
 struct ExportJob {
   enum class Kind { kPreview, kExport, kFinal } kind = Kind::kExport;
-  TriangleMesh model;  // Raw marching cubes, object frame.
-  // Previews: what the camera saw and where the model and the hand were.
+  TriangleMesh model;  // Exports: raw marching cubes, object frame.
+  // Previews: what the camera saw, the model seen from the camera, and the posed hand.
   std::shared_ptr<const Frame> frame;
+  ModelView model_view;
   std::shared_ptr<const TriangleMesh> hand;
-  Rigid3 cam_from_object;
   // Exports: the scan's log so far.
   std::shared_ptr<const ScanRecord> record;
 };
 using JobPtr = std::unique_ptr<ExportJob>;
 
-// The model seen from the camera, shaded by the angle to the view ray, in its colours.
-RgbImage ShadedRaycast(const fusion::TsdfVolume& volume, const CameraIntrinsics& intrinsics,
-                       const Rigid3& cam_from_object) {
-  const fusion::RaycastImage cast = volume.Raycast(intrinsics, cam_from_object);
-  RgbImage image{cast.width, cast.height, {}};
-  image.rgb.assign(static_cast<std::size_t>(cast.width) * cast.height * 3, 0);
+// The model seen from the camera, shaded by the angle to the view ray, in its colours, with its
+// depth.
+ModelView ViewModel(const fusion::TsdfVolume& volume, const CameraIntrinsics& intrinsics,
+                    const Rigid3& cam_from_object) {
+  fusion::RaycastImage cast = volume.Raycast(intrinsics, cam_from_object);
+  ModelView view;
+  view.image = {cast.width, cast.height, {}};
+  view.image.rgb.assign(static_cast<std::size_t>(cast.width) * cast.height * 3, 0);
   for (std::size_t i = 0; i < cast.depth_mm.size(); ++i) {
     if (cast.depth_mm[i] <= 0) continue;
     const float shade = 0.25f + 0.75f * std::abs(cast.normals[i].z());
     const bool colored = i < cast.colors.size();
     for (int c = 0; c < 3; ++c) {
       const float base = colored ? cast.colors[i][c] : 200.0f;
-      image.rgb[i * 3 + c] = static_cast<std::uint8_t>(std::min(255.0f, base * shade));
+      view.image.rgb[i * 3 + c] = static_cast<std::uint8_t>(std::min(255.0f, base * shade));
     }
   }
-  return image;
+  view.depth_mm = std::move(cast.depth_mm);
+  return view;
 }
 
 // The process's peak resident memory so far, MiB.
@@ -257,19 +260,22 @@ void Pipeline::FusionLoop() {
   auto record = std::make_shared<ScanRecord>(s.bone_names);
   std::int64_t previewed_at = 0;
   std::int64_t live_view_frame = -1000;
-  // Hands a snapshot to the export thread; false when it is busy (try again later).
+  // Hands a snapshot to the export thread; false when it is busy (try again later). Only this
+  // thread pushes, so a queue with room now still has room after the snapshot is made.
   auto submit = [&](ExportJob::Kind kind, const FramePacket* packet) {
+    const bool final = kind == ExportJob::Kind::kFinal;
+    if (!final && s.jobs.SizeApprox() >= s.jobs.capacity()) return false;
     auto job = std::make_unique<ExportJob>();
     job->kind = kind;
-    if (object) job->model = object->Snapshot();
     if (kind == ExportJob::Kind::kPreview) {
       job->frame = packet->frame;
+      job->model_view = ViewModel(object->volume(), s.intrinsics, packet->fusion.cam_from_object);
       job->hand = packet->hand_mesh;
-      job->cam_from_object = packet->fusion.cam_from_object;
     } else {
+      if (object) job->model = object->Snapshot();
       job->record = std::make_shared<ScanRecord>(*record);
     }
-    if (kind == ExportJob::Kind::kFinal) return s.jobs.Push(std::move(job));
+    if (final) return s.jobs.Push(std::move(job));
     return s.jobs.TryPush(std::move(job));
   };
   try {
@@ -282,6 +288,7 @@ void Pipeline::FusionLoop() {
         object = std::make_unique<ObjectStage>(options_, s.intrinsics);
         record = std::make_shared<ScanRecord>(s.bone_names);
         s.registered = 0;
+        previewed_at = 0;
       }
       if (export_requested_.load() && object->started() &&
           submit(ExportJob::Kind::kExport, nullptr)) {
@@ -312,7 +319,8 @@ void Pipeline::FusionLoop() {
         view.joint_parents = s.joint_parents;
         for (const auto& pair : packet->track.contact_pairs)
           view.contacts_mm.push_back(pair.current_mm);
-        view.model = ShadedRaycast(object->volume(), s.intrinsics, packet->fusion.cam_from_object);
+        view.model =
+            ViewModel(object->volume(), s.intrinsics, packet->fusion.cam_from_object).image;
         view.tracking = tracker::ToString(packet->track.status);
         live_view_.Put(std::move(view));
       }
@@ -349,7 +357,7 @@ void Pipeline::ExportLoop() {
         char name[32];
         std::snprintf(name, sizeof(name), "%06lld.png", static_cast<long long>(job->frame->index));
         WritePng(output_.folder / "preview" / name,
-                 previews->Draw(*job->frame, job->model, job->cam_from_object, job->hand.get()));
+                 previews->Draw(*job->frame, job->model_view, job->hand.get()));
         continue;
       }
       const bool final = job->kind == ExportJob::Kind::kFinal;

@@ -19,16 +19,9 @@ PreviewRenderer::PreviewRenderer(const CameraIntrinsics& intrinsics) {
 
 PreviewRenderer::~PreviewRenderer() = default;
 
-RgbImage PreviewRenderer::Draw(const Frame& frame, const TriangleMesh& model,
-                               const Rigid3& cam_from_object, const TriangleMesh* hand) {
+RgbImage PreviewRenderer::Draw(const Frame& frame, const ModelView& model,
+                               const TriangleMesh* hand) {
   std::vector<render::RenderItem> items;
-  if (!model.faces.empty()) {
-    render::RenderItem item;
-    item.mesh = &model;
-    item.cam_from_mesh = cam_from_object;
-    item.use_vertex_colors = !model.colors.empty();
-    items.push_back(item);
-  }
   if (hand && !hand->faces.empty()) {
     render::RenderItem item;
     item.mesh = hand;
@@ -38,6 +31,9 @@ RgbImage PreviewRenderer::Draw(const Frame& frame, const TriangleMesh& model,
   }
   const render::RenderOutput rendered = renderer_->Render(items);
   const int width = rendered.width, height = rendered.height;
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  const bool model_fits =
+      model.image.width == width && model.image.height == height && model.depth_mm.size() == pixels;
 
   RgbImage image;
   image.width = 2 * width;
@@ -46,16 +42,24 @@ RgbImage PreviewRenderer::Draw(const Frame& frame, const TriangleMesh& model,
   const bool same_size = frame.width == width && frame.height == height;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * width + u;
       std::uint8_t* left = &image.rgb[(static_cast<std::size_t>(v) * image.width + u) * 3];
       if (same_size && frame.HasColor()) {
-        std::copy_n(&frame.rgb[(static_cast<std::size_t>(v) * width + u) * 3], 3, left);
+        std::copy_n(&frame.rgb[i * 3], 3, left);
       } else if (same_size) {
         const int depth = frame.DepthAt(u, v);
         const auto grey = static_cast<std::uint8_t>(depth ? 255 - std::min(depth / 6, 230) : 0);
         std::fill_n(left, 3, grey);
       }
-      std::copy_n(&rendered.rgb[(static_cast<std::size_t>(v) * width + u) * 3], 3,
-                  left + width * 3);
+      // The nearer of the model and the hand, over the renderer's background.
+      std::uint8_t* right = left + width * 3;
+      const float model_depth = model_fits ? model.depth_mm[i] : 0.0f;
+      const float hand_depth = rendered.depth_mm[i];
+      if (model_depth > 0 && (hand_depth <= 0 || model_depth < hand_depth)) {
+        std::copy_n(&model.image.rgb[i * 3], 3, right);
+      } else {
+        std::copy_n(&rendered.rgb[i * 3], 3, right);
+      }
     }
   }
   return image;

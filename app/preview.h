@@ -1,6 +1,7 @@
 #pragma once
-// Preview images of a scan in progress, drawn by the off-screen renderer (OSMesa): the camera's
-// colour image beside the model so far and the posed hand model, both seen from the camera.
+// Preview images of a scan in progress: the camera's colour image beside the model so far (a
+// raycast of the TSDF) and the posed hand model drawn by the off-screen renderer (OSMesa), both
+// seen from the camera.
 
 #include <cstdint>
 #include <filesystem>
@@ -9,7 +10,6 @@
 
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
-#include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 
 namespace ihs::render {
@@ -25,6 +25,13 @@ struct RgbImage {
   std::vector<std::uint8_t> rgb;
 };
 
+/// The model as the camera sees it: a shaded image and the depth of its surface per pixel (mm,
+/// 0 where there is none), row-major.
+struct ModelView {
+  RgbImage image;
+  std::vector<float> depth_mm;
+};
+
 /// Draws previews. One per thread (it owns an OSMesa context).
 class PreviewRenderer {
  public:
@@ -32,11 +39,9 @@ class PreviewRenderer {
   explicit PreviewRenderer(const CameraIntrinsics& intrinsics);
   ~PreviewRenderer();
 
-  /// The colour image of `frame` (its depth in grey when it has no colour) beside `model`
-  /// (object frame, placed by `cam_from_object`, in its vertex colours) and `hand` (camera
-  /// frame, skin-coloured; may be null).
-  RgbImage Draw(const Frame& frame, const TriangleMesh& model, const Rigid3& cam_from_object,
-                const TriangleMesh* hand);
+  /// The colour image of `frame` (its depth in grey when it has no colour) beside `model` with
+  /// `hand` (camera frame, skin-coloured; may be null) drawn in where it is nearer.
+  RgbImage Draw(const Frame& frame, const ModelView& model, const TriangleMesh* hand);
 
  private:
   std::unique_ptr<render::OffscreenRenderer> renderer_;
