@@ -90,7 +90,12 @@ std::string MessageOf(const std::exception_ptr& error) {
 }  // namespace
 
 struct Pipeline::Shared {
-  Shared(std::size_t capacity) : frames(capacity), tracked(capacity), jobs(2) {}
+  // Live, the tracker hands the fusion thread one frame at a time: frames wait (and are
+  // dropped) before the tracker, where a dropped frame costs nothing but itself; after it, a
+  // dropped frame would leave the next one's contact pairs pointing at a frame the fusion never
+  // saw.
+  Shared(std::size_t capacity, bool live)
+      : frames(capacity), tracked(live ? 1 : capacity), jobs(2), live(live) {}
 
   SpscQueue<PacketPtr> frames;   // capture → tracker
   SpscQueue<PacketPtr> tracked;  // tracker → fusion
@@ -100,11 +105,13 @@ struct Pipeline::Shared {
   std::vector<std::string> bone_names;
   std::vector<int> joint_parents;  // Joint j+1 ends bone j, which starts where its parent ends.
   std::chrono::steady_clock::time_point start;
-  bool live = false;
+  const bool live;
 
   std::atomic<std::int64_t> captured{0}, processed{0}, registered{0}, exports{0};
   std::atomic<double> processing_seconds{0};  // From Start() to the last frame fused.
-  std::atomic<std::int64_t> dropped_capture{0}, dropped_tracker{0}, previews_skipped{0};
+  // Live drops: frames the capture queue had no room for, and queued frames the tracker passed
+  // over for a newer one.
+  std::atomic<std::int64_t> dropped_capture{0}, dropped_stale{0}, previews_skipped{0};
   mutable std::mutex mutex;  // Guards what follows.
   std::condition_variable done;
   std::string tracking = "waiting";
@@ -121,7 +128,6 @@ Pipeline::Pipeline(std::unique_ptr<sensor::FrameSource> source, ScannerOptions o
     : source_(std::move(source)), options_(std::move(options)), output_(std::move(output)) {
   options_.Check();
   if (!source_) throw std::invalid_argument("Pipeline: no frame source");
-  shared_ = std::make_unique<Shared>(options_.pipeline.queue_capacity);
 }
 
 Pipeline::~Pipeline() {
@@ -146,8 +152,8 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
     std::filesystem::create_directories(output_.folder / "preview", error);
   }
   source_->Start();
+  shared_ = std::make_unique<Shared>(options_.pipeline.queue_capacity, source_->IsLive());
   shared_->intrinsics = source_->Intrinsics();
-  shared_->live = source_->IsLive();
   shared_->hand = std::make_unique<HandStage>(options_, shared_->intrinsics);
   shared_->bone_names = shared_->hand->BoneNames();
   shared_->joint_parents = {-1};
@@ -233,18 +239,22 @@ void Pipeline::TrackerLoop() {
   Shared& s = *shared_;
   try {
     PacketPtr packet;
-    while (s.frames.Pop(packet) == PopStatus::kItem) {
+    while (true) {
+      // Live, the newest frame: the older ones queued meanwhile would only add latency.
+      std::size_t skipped = 0;
+      const PopStatus status = s.live
+                                   ? s.frames.PopLatest(packet, std::chrono::seconds(1), &skipped)
+                                   : s.frames.Pop(packet);
+      s.dropped_stale += static_cast<std::int64_t>(skipped);
+      if (status == PopStatus::kTimeout) continue;
+      if (status == PopStatus::kClosed) break;
       s.hand->Process(*packet);
       {
         std::lock_guard<std::mutex> lock(s.mutex);
         s.tracking = packet->frame_error.empty() ? tracker::ToString(packet->track.status)
                                                  : "malformed frame";
       }
-      if (s.live) {
-        if (!s.tracked.TryPush(std::move(packet))) ++s.dropped_tracker;
-      } else if (!s.tracked.Push(std::move(packet))) {
-        break;  // The fusion thread has stopped.
-      }
+      if (!s.tracked.Push(std::move(packet))) break;  // The fusion thread has stopped.
     }
   } catch (...) {
     Fail("tracker", std::current_exception());
@@ -372,7 +382,7 @@ void Pipeline::ExportLoop() {
                               {"dropped_frames",
                                {{"missed_by_source", source_->MissedFrames()},
                                 {"capture_queue_full", s.dropped_capture.load()},
-                                {"tracker_queue_full", s.dropped_tracker.load()}}},
+                                {"skipped_stale", s.dropped_stale.load()}}},
                               {"previews_skipped", s.previews_skipped.load()},
                               {"seconds", progress.seconds},
                               {"processing_seconds", progress.processing_seconds},
@@ -422,12 +432,13 @@ bool Pipeline::Wait(std::chrono::milliseconds timeout) {
 }
 
 PipelineProgress Pipeline::Progress() const {
-  const Shared& s = *shared_;
   PipelineProgress progress;
+  if (!shared_) return progress;
+  const Shared& s = *shared_;
   progress.captured = s.captured.load();
   progress.processed = s.processed.load();
   progress.registered = s.registered.load();
-  progress.dropped = s.dropped_capture.load() + s.dropped_tracker.load();
+  progress.dropped = s.dropped_capture.load() + s.dropped_stale.load();
   progress.exports = s.exports.load();
   if (source_) progress.total = source_->FrameCount();
   if (started_) progress.seconds = MillisecondsSince(s.start) / 1000.0;
@@ -439,7 +450,10 @@ PipelineProgress Pipeline::Progress() const {
   return progress;
 }
 
-CameraIntrinsics Pipeline::intrinsics() const { return shared_->intrinsics; }
+CameraIntrinsics Pipeline::intrinsics() const {
+  if (!shared_) throw std::logic_error("Pipeline::intrinsics before Start");
+  return shared_->intrinsics;
+}
 
 PipelineResult Pipeline::Finish() {
   PipelineResult result;

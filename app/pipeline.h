@@ -8,8 +8,9 @@
 //                                                  export thread (meshes, files, previews)
 //
 // Live sources (a device, or a recording paced in real time) never block the capture thread:
-// when a stage falls behind, frames are dropped and counted. Recordings replayed as fast as
-// possible block instead, so two replays give identical results. Exports in mid-scan are
+// when the tracker falls behind, frames are dropped and counted before it (it always takes the
+// newest), and the fusion thread gets every tracked frame, one at a time. Recordings replayed as
+// fast as possible block instead, so two replays give identical results. Exports in mid-scan are
 // requests to the fusion thread, answered with a snapshot of the model that the export thread
 // meshes while the scan goes on. Stop (or the end of the input) lets every thread finish the
 // frames in hand; a failing thread stores its error and stops the others, and the model so far

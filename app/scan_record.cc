@@ -40,6 +40,9 @@ void ScanRecord::Add(const FramePacket& packet) {
     ++track_counts_[tracker::ToString(track.status)];
     if (!track.reason.empty()) entry["track_reason"] = track.reason;
     timing("track_ms", track.milliseconds);
+    timing("segmentation_ms", track.segmentation_ms);
+    timing("hand_fit_ms", track.fit_ms);
+    timing("contacts_ms", track.contacts_ms);
     timing("mask_ms", packet.mask_ms);
     timing("features_ms", packet.features_ms);
     entry["hand_pixels_removed"] = packet.hand_pixels_removed;
@@ -50,14 +53,12 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (track.HasPose()) {
       const Eigen::Quaterniond q = track.pose.cam_from_root.quaternion();
       const Eigen::Vector3d t = track.pose.cam_from_root.translation();
+      std::vector<double> values = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+      values.insert(values.end(), track.pose.angles_rad.begin(), track.pose.angles_rad.end());
       std::string row = std::to_string(frame.index);
       char buffer[48];
-      for (double value : {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()}) {
+      for (double value : values) {
         std::snprintf(buffer, sizeof(buffer), ",%.6g", value);
-        row += buffer;
-      }
-      for (double angle : track.pose.angles_rad) {
-        std::snprintf(buffer, sizeof(buffer), ",%.6g", angle);
         row += buffer;
       }
       pose_rows_.push_back(std::move(row));

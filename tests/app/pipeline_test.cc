@@ -346,7 +346,7 @@ TEST_F(PipelineFaultTest, ALiveSourceDropsFramesRatherThanBlockingTheCapture) {
   const nlohmann::json stats = Stats(out.path());
   EXPECT_EQ(stats["summary"]["live"], true);
   EXPECT_EQ(stats["summary"]["dropped_frames"]["capture_queue_full"].get<int>() +
-                stats["summary"]["dropped_frames"]["tracker_queue_full"].get<int>(),
+                stats["summary"]["dropped_frames"]["skipped_stale"].get<int>(),
             result.progress.dropped);
 }
 
