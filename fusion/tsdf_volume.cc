@@ -71,6 +71,7 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   };
 
   // The voxels within the band around each observed pixel's surface point, along its ray.
+  const int samples = static_cast<int>(std::floor(2.0f * band / (0.5f * voxel))) + 1;
   std::vector<std::int64_t> touched;
   for (int v = 0; v < frame.height; ++v) {
     for (int u = 0; u < frame.width; ++u) {
@@ -79,11 +80,14 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
       const Eigen::Vector3f point =
           intrinsics.BackProject(u, v, frame.depth_mm[pixel]).cast<float>();
       const Eigen::Vector3f ray = point.normalized();
-      for (float t = -band; t <= band; t += 0.5f * voxel) {
-        const Eigen::Vector3f grid = (rotation * (point + t * ray) + translation).array() + half;
-        const int i = static_cast<int>(std::floor(grid.x() / voxel));
-        const int j = static_cast<int>(std::floor(grid.y() / voxel));
-        const int k = static_cast<int>(std::floor(grid.z() / voxel));
+      // Half-voxel steps along the ray, in voxel units of the volume's grid.
+      const Eigen::Vector3f step = rotation * ray * 0.5f;
+      Eigen::Vector3f grid =
+          ((rotation * (point - band * ray) + translation).array() + half) / voxel;
+      for (int s = 0; s < samples; ++s, grid += step) {
+        const int i = static_cast<int>(std::floor(grid.x()));
+        const int j = static_cast<int>(std::floor(grid.y()));
+        const int k = static_cast<int>(std::floor(grid.z()));
         if (i < 0 || j < 0 || k < 0 || i >= n_ || j >= n_ || k >= n_) continue;
         const std::int64_t index = Index(i, j, k);
         // Each voxel once: a bit per voxel, set here and cleared again below.
