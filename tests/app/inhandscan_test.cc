@@ -129,6 +129,25 @@ TEST_F(InhandscanSignalTest, SigusrOneExportsAndTheReplayGoesOn) {
   EXPECT_TRUE(ReadMesh(out / "mesh.ply").IsWatertight());
 }
 
+TEST_F(InhandscanSignalTest, ReplayWritesEveryOutputAndTheFormatsAskedFor) {
+  test::TempDir out;
+  const auto run =
+      RunApp("replay " + (*dir_ / "sequence.oni").string() + " --out " + out.path().string() +
+             " --format obj,stl --set pipeline.max_frames=31 --quiet");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out, "mesh: " + (out / "mesh.ply").string() + "\n");
+  const TriangleMesh ply = ReadMesh(out / "mesh.ply");
+  EXPECT_TRUE(ply.IsWatertight());
+  EXPECT_EQ(ReadMesh(out / "mesh.obj").faces.size(), ply.faces.size());
+  EXPECT_EQ(ReadMesh(out / "mesh.stl").faces.size(), ply.faces.size());
+  for (const char* name :
+       {"mesh_tsdf.ply", "trajectory.txt", "hand_joints.csv", "hand_poses.csv", "stats.json"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name;
+  }
+  // A preview every 30 fused frames.
+  EXPECT_FALSE(fs::is_empty(out / "preview"));
+}
+
 TEST_F(InhandscanSignalTest, SigintFinishesExportsAndExitsZero) {
   test::TempDir out;
   const auto run = ReplayWithSignal(out.path(), "INT", 1.5);
