@@ -183,7 +183,9 @@ int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
   for (const fs::path& file : result.files) {
     if (file.filename() == "mesh.ply") std::printf("mesh: %s\n", file.c_str());
   }
-  if (!result.error.empty()) std::fprintf(stderr, "inhandscan: error: %s\n", result.error.c_str());
+  if (!result.error.empty()) {
+    std::fprintf(stderr, "inhandscan: error: %s\n", ihs::OneLine(result.error).c_str());
+  }
   return result.exit_code;
 }
 

@@ -13,9 +13,31 @@ std::string ExitCodesHelp() {
          "4 device problem, 5 a stage failed (partial result saved), 6 output not writable.";
 }
 
+std::string OneLine(const std::string& message) {
+  // Runs of whitespace with a line break become "; ", other runs one space; none at the ends.
+  std::string line;
+  bool pending_space = false, pending_break = false;
+  for (const char ch : message) {
+    if (ch == '\n' || ch == '\r') {
+      pending_break = true;
+    } else if (ch == ' ' || ch == '\t') {
+      pending_space = true;
+    } else {
+      if (!line.empty() && pending_break) {
+        line += "; ";
+      } else if (!line.empty() && pending_space) {
+        line += ' ';
+      }
+      pending_space = pending_break = false;
+      line += ch;
+    }
+  }
+  return line;
+}
+
 int RunReportingErrors(const std::string& program, const std::function<int()>& body) {
   auto report = [&](const char* what, int code) {
-    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), what);
+    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), OneLine(what).c_str());
     return code;
   };
   try {

@@ -21,10 +21,14 @@ enum ExitCode : int {
 /// One line for --help listing the codes above.
 std::string ExitCodesHelp();
 
+/// `message` on one line: runs of whitespace that hold a line break become "; ", other runs a
+/// single space.
+std::string OneLine(const std::string& message);
+
 /// Runs `body` and returns its exit code; an exception escaping it is printed to stderr as one
-/// line "<program>: error: <message>" and mapped to its exit code (std::invalid_argument →
-/// kExitUsage, InputError → kExitInput, DeviceError → kExitDevice, OutputError → kExitOutput,
-/// anything else → kExitInternal).
+/// line "<program>: error: <message>" (see OneLine) and mapped to its exit code
+/// (std::invalid_argument → kExitUsage, InputError → kExitInput, DeviceError → kExitDevice,
+/// OutputError → kExitOutput, anything else → kExitInternal).
 int RunReportingErrors(const std::string& program, const std::function<int()>& body);
 
 }  // namespace ihs

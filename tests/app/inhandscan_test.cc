@@ -77,6 +77,7 @@ TEST(InhandscanTest, LiveWithoutACameraSaysSoWithCodeFour) {
   if (run.exit_code == 0) GTEST_SKIP() << "a camera is attached";
   EXPECT_EQ(run.exit_code, 4) << run.err;
   EXPECT_NE(run.err.find("camera"), std::string::npos) << run.err;
+  EXPECT_EQ(Lines(run.err), 1) << run.err;
   const auto devices = RunApp("devices");
   EXPECT_EQ(devices.exit_code, 4) << devices.err;
   EXPECT_NE(devices.out.find("OpenNI2"), std::string::npos) << devices.out;
