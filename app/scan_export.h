@@ -21,9 +21,10 @@ struct ExportedMeshes {
   double milliseconds = 0;
 };
 
-/// Meshes `raw` with `options` and writes mesh_tsdf.ply, mesh.ply (when Poisson gave a mesh) and
-/// mesh.<ext> for each of `extra_formats` ("obj", "stl", "ply") into `folder`. Nothing is written
-/// when `raw` has no faces. Throws ihs::OutputError when a file cannot be written.
+/// Meshes `raw` with `options` and writes into `folder`: mesh_tsdf.ply (the smoothed surface),
+/// mesh.ply (the watertight mesh; the smoothed one when Poisson is off or gave nothing) and
+/// mesh.<ext> of the same for each of `extra_formats` ("obj", "stl"; "ply" adds nothing). Nothing
+/// is written when `raw` has no faces. Throws ihs::OutputError when a file cannot be written.
 ExportedMeshes ExportMeshes(const TriangleMesh& raw, const fusion::MeshingOptions& options,
                             const std::filesystem::path& folder,
                             const std::vector<std::string>& extra_formats = {});
