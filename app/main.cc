@@ -295,10 +295,12 @@ int main(int argc, char** argv) {
       ihs::sensor::OpenNiOptions device;
       device.uri = args.device;
       std::atomic<bool> stop{false};
-      const auto max_duration =
+      // No --seconds: until Ctrl-C (a year stands for "no limit": the recorder compares it with
+      // a clock difference in nanoseconds, which milliseconds::max() would overflow).
+      const std::chrono::milliseconds max_duration =
           record_seconds > 0
               ? std::chrono::milliseconds(static_cast<long long>(record_seconds * 1000))
-              : std::chrono::milliseconds::max();
+              : std::chrono::hours(24 * 365);
       // The recorder polls `stop`; the signal handler only counts signals.
       std::thread watcher([&] {
         while (!stop.load()) {
