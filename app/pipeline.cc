@@ -119,7 +119,6 @@ struct Pipeline::Shared {
   std::string failed_stage;
   std::exception_ptr failure;
   std::vector<std::filesystem::path> final_files;
-  bool final_export_done = false;
   int running = 0;  // Threads still running.
 };
 
@@ -416,7 +415,6 @@ void Pipeline::ExportLoop() {
       if (final) {
         std::lock_guard<std::mutex> lock(s.mutex);
         s.final_files = exported.files;
-        s.final_export_done = true;
       }
     } catch (...) {
       Fail("export", std::current_exception());

@@ -1,6 +1,5 @@
 #include "app/scan_stages.h"
 
-#include <exception>
 
 #include "core/errors.h"
 #include "core/stopwatch.h"
