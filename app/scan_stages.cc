@@ -1,6 +1,5 @@
 #include "app/scan_stages.h"
 
-
 #include "core/errors.h"
 #include "core/stopwatch.h"
 #include "fusion/object_mask.h"
