@@ -19,6 +19,7 @@
 #include "app/live_screen.h"
 #include "app/pipeline.h"
 #include "app/scanner_options.h"
+#include "core/command_line.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
@@ -264,13 +265,7 @@ int main(int argc, char** argv) {
   CLI::App* config =
       app.add_subcommand("config", "print every option with its default and meaning");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);
-    std::fprintf(stderr, "inhandscan: error: %s (see --help)\n", error.what());
-    return ihs::kExitUsage;
-  }
+  if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan", [&]() -> int {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
     ihs::app::ScannerOptions options;

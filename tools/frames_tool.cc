@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "sensor/oni_writer.h"
@@ -138,13 +139,7 @@ int main(int argc, char** argv) {
   convert->add_option("output", output, ".oni file or TUM folder to write")->required();
   add_input_options(convert);
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);
-    std::fprintf(stderr, "inhandscan-frames: error: %s (see --help)\n", error.what());
-    return ihs::kExitUsage;
-  }
+  if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-frames", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
     ihs::sensor::InputOptions options;

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "core/atomic_file.h"
+#include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "core/mesh_io.h"
@@ -81,13 +82,7 @@ int main(int argc, char** argv) {
   app.add_option("--json", json, "also write the results as JSON to this file");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);
-    std::fprintf(stderr, "inhandscan-measure: error: %s (see --help)\n", error.what());
-    return ihs::kExitUsage;
-  }
+  if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-measure", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
     return Run(mesh, object, gt, trajectory, json);

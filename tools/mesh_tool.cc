@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "core/mesh_io.h"
@@ -67,13 +68,7 @@ int main(int argc, char** argv) {
   convert->add_option("output", output, "mesh file to write (.ply, .obj, .stl)")->required();
   convert->add_flag("--ascii", ascii, "write PLY as ASCII instead of binary");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);
-    std::fprintf(stderr, "inhandscan-mesh: error: %s (see --help)\n", error.what());
-    return ihs::kExitUsage;
-  }
+  if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-mesh", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
     return info->parsed() ? PrintInfo(input) : Convert(input, output, ascii);

@@ -21,6 +21,7 @@
 #include "app/scan_export.h"
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
+#include "core/command_line.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
@@ -213,13 +214,7 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);
-    std::fprintf(stderr, "inhandscan-scan: error: %s (see --help)\n", error.what());
-    return ihs::kExitUsage;
-  }
+  if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   if (args.contacts_only && args.gamma_t <= 0) {
     std::fprintf(stderr, "inhandscan-scan: error: --contacts-only needs --gamma-t > 0\n");
     return ihs::kExitUsage;

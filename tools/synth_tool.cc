@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "tools/synth/sequence.h"
@@ -75,13 +76,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "output folder")->required();
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);
-    std::fprintf(stderr, "inhandscan-synth: error: %s (see --help)\n", error.what());
-    return ihs::kExitUsage;
-  }
+  if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-synth", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
     if (preset == "demo") {
