@@ -192,6 +192,8 @@ TrajectoryError CompareTrajectory(const fs::path& gt_dir,
     sum += error;
     result.max_mm = std::max(result.max_mm, error);
     result.final_mm = error;
+    result.times_s.push_back(pose.time_s);
+    result.errors_mm.push_back(error);
     ++result.frames;
   }
   result.mean_mm = result.frames ? sum / result.frames : 0;
@@ -217,44 +219,48 @@ fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const Triangl
 
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const fs::path& gt_dir,
-                          const std::vector<StampedPose>& trajectory) {
+                          const std::vector<StampedPose>& trajectory, std::FILE* out) {
+  // Prints to `out` unless it is null.
+  auto print = [out](const char* format, auto... values) {
+    if (out) std::fprintf(out, format, values...);
+  };
   nlohmann::json report = nlohmann::json::object();
   if (!object.empty()) {
     const std::vector<DimensionRow> rows = PaperDimensions(object, seen);
-    std::printf("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
+    print("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
     double sum = 0;
     for (const DimensionRow& row : rows) {
-      std::printf("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm,
-                  row.captured_mm, row.Error());
+      print("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm, row.captured_mm,
+            row.Error());
       report["dimensions"].push_back(
           {{"measure", row.measure}, {"truth_mm", row.truth_mm}, {"scan_mm", row.captured_mm}});
       sum += std::abs(row.Error());
     }
     report["dimension_error_mm_mean"] = sum / rows.size();
-    std::printf("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
+    print("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
     if (watertight.IsWatertight()) {
       const double truth = TrueVolume(object), volume = watertight.Volume();
-      std::printf("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%\n", truth, volume,
-                  100 * (volume / truth - 1));
+      print("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%\n", truth, volume,
+            100 * (volume / truth - 1));
       report["volume_mm3"] = {{"truth", truth}, {"scan", volume}};
       report["volume_error"] = volume / truth - 1;
     }
   }
   if (!gt_dir.empty()) {
     const PairwiseError pairwise = ContactPairwiseError(gt_dir, trajectory);
-    std::printf("pairwise registration error at the fingertips: %.2f ± %.2f mm (median %.2f, %d)\n",
-                pairwise.mean_mm, pairwise.std_mm, pairwise.median_mm, pairwise.samples);
+    print("pairwise registration error at the fingertips: %.2f ± %.2f mm (median %.2f, %d)\n",
+          pairwise.mean_mm, pairwise.std_mm, pairwise.median_mm, pairwise.samples);
     report["pairwise_error_mm"] = {{"mean", pairwise.mean_mm},
                                    {"std", pairwise.std_mm},
                                    {"median", pairwise.median_mm},
                                    {"samples", pairwise.samples}};
     const TrajectoryError drift = CompareTrajectory(gt_dir, trajectory);
-    std::printf("object trajectory error: %.2f mm mean, %.2f mm max, %.2f mm at the end\n",
-                drift.mean_mm, drift.max_mm, drift.final_mm);
+    print("object trajectory error: %.2f mm mean, %.2f mm max, %.2f mm at the end\n", drift.mean_mm,
+          drift.max_mm, drift.final_mm);
     report["trajectory_error_mm"] = {
         {"mean", drift.mean_mm}, {"max", drift.max_mm}, {"final", drift.final_mm}};
     const fusion::SurfaceComparison surface = CompareWithTruth(gt_dir, seen, trajectory);
-    std::printf(
+    print(
         "surface: Chamfer %.2f mm (scan→truth %.2f, truth→scan %.2f), completeness %.1f %% "
         "(within %.1f mm)\n",
         surface.chamfer_mm, surface.scan_to_truth_mm, surface.truth_to_scan_mm,

@@ -4,6 +4,7 @@
 // and the surface's Chamfer distance and completeness after aligning by the known trajectory.
 // Shared by inhandscan-scan, inhandscan-measure and the benchmark.
 
+#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
@@ -67,11 +68,14 @@ struct TrajectoryError {
   double max_mm = 0;
   double final_mm = 0;
   int frames = 0;
+  /// Per compared frame: its time stamp (s) and its error (mm).
+  std::vector<double> times_s, errors_mm;
 };
 TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
                                   const std::vector<StampedPose>& trajectory);
 
-/// Prints a scan's measures as a table for people on stdout and returns them as JSON: with
+/// Prints a scan's measures as a table for people on `out` (nullptr: prints nothing) and returns
+/// them as JSON: with
 /// `object` (a paper object or lathe:FILE) the paper's dimensions measured on `seen` ("dimensions",
 /// "dimension_error_mm_mean") and, when `watertight` is, its volume against the truth
 /// ("volume_mm3", "volume_error"); with `gt_dir` the pairwise registration error at the
@@ -79,7 +83,7 @@ TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
 /// "trajectory_error_mm", "chamfer_mm", "completeness"), `seen` placed by `trajectory`.
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const std::filesystem::path& gt_dir,
-                          const std::vector<StampedPose>& trajectory);
+                          const std::vector<StampedPose>& trajectory, std::FILE* out = stdout);
 
 /// The pose of `trajectory` stamped `time_s` (within half a millisecond), or nullptr.
 const StampedPose* FindPose(const std::vector<StampedPose>& trajectory, double time_s);

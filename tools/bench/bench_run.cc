@@ -1,0 +1,280 @@
+#include "tools/bench/bench_run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "app/scan_export.h"
+#include "app/scan_record.h"
+#include "app/scan_stages.h"
+#include "core/errors.h"
+#include "core/stopwatch.h"
+#include "fusion/surface_mesh.h"
+#include "render/offscreen_renderer.h"
+#include "sensor/open_input.h"
+#include "tools/bench/open3d_baseline.h"
+#include "tools/evaluation.h"
+#include "tools/synth/sequence.h"
+#include "tracker/hand_fit.h"
+#include "tracker/hand_joints_io.h"
+
+namespace ihs::bench {
+namespace fs = std::filesystem;
+
+std::vector<double> GammaSweep() { return {0, 1, 5, 10, 15, 20, 30}; }
+
+std::vector<Method> DefaultMethods(const std::vector<double>& sweep) {
+  std::vector<Method> methods = {{"ours", 15, true, true, false},
+                                 {"visual-only", 0, true, true, false},
+                                 {"contacts-only", 15, false, true, false},
+                                 {"no-icp", 15, true, false, false}};
+  for (double gamma : sweep) {
+    if (gamma == 0 || gamma == 15) continue;  // Visual only and ours.
+    char name[32];
+    std::snprintf(name, sizeof name, "gamma-%g", gamma);
+    methods.push_back({name, gamma, true, true, true});
+  }
+  return methods;
+}
+
+std::vector<BenchCase> DefaultCases(const fs::path& data, int frames) {
+  std::vector<BenchCase> cases;
+  if (!data.empty()) {
+    const std::pair<const char*, const char*> sessions[] = {{"001-water-bottle", "water-bottle"},
+                                                            {"002-bowling-pin", "bowling-pin"},
+                                                            {"003-small-bottle", "small-bottle"},
+                                                            {"004-sphere", "sphere"}};
+    for (const auto& [session, object] : sessions) {
+      cases.push_back({session, object, "recorded:" + (data / "sequences" / session).string(),
+                       false, frames, true, 1, false});
+    }
+  }
+  // Scripted full turns (one turn in 240 frames, re-grasping every 90°) with another seed than
+  // the recorded ones, and a textured box: the case visual features are made for.
+  const int scripted = frames > 0 ? std::min(frames, 240) : 240;
+  cases.push_back({"sphere-turn", "sphere", "scripted", false, scripted, false, 7, true});
+  cases.push_back({"bowling-pin-turn", "bowling-pin", "scripted", false, scripted, false, 7, true});
+  cases.push_back({"textured-box-turn", "box", "scripted", true, scripted, false, 7, true});
+  return cases;
+}
+
+namespace {
+
+// Renders the case's sequence into `dir` unless the one there was made from the same options.
+void GenerateIfNeeded(const BenchCase& c, const fs::path& dir, bool quiet) {
+  synth::SequenceOptions options;
+  options.object = c.object;
+  options.textured = c.textured;
+  options.motion = c.motion;
+  options.last_frame = c.frames > 0 ? c.frames - 1 : -1;
+  options.seed = c.seed;
+  options.write_tum = false;
+  const nlohmann::json key = {{"object", c.object}, {"textured", c.textured},
+                              {"motion", c.motion}, {"frames", c.frames},
+                              {"seed", c.seed},     {"version", IHS_VERSION}};
+  const fs::path key_file = dir / "bench-key.json";
+  std::ifstream in(key_file);
+  std::stringstream cached;
+  cached << in.rdbuf();
+  if (cached.str() == key.dump() && fs::exists(dir / "sequence.oni") &&
+      fs::exists(dir / "gt" / "trajectory.txt"))
+    return;
+  if (!quiet) std::fprintf(stderr, "inhandscan-bench: rendering %s...\n", c.name.c_str());
+  fs::remove_all(dir);
+  synth::GenerateSequence(options, dir);
+  std::ofstream(key_file) << key.dump();
+}
+
+// One method's stage and log during the pass over the frames.
+struct Runner {
+  Method method;
+  app::ScannerOptions options;
+  std::unique_ptr<app::ObjectStage> stage;
+  std::unique_ptr<app::ScanRecord> record;
+};
+
+app::ScannerOptions OptionsFor(const Method& method) {
+  app::ScannerOptions options;
+  options.scan.features_2d = method.visual;
+  options.fusion.pairwise.contact_weight = method.gamma_t;
+  if (!method.visual) options.fusion.pairwise.visual_weight = 0;
+  options.fusion.use_icp = method.icp;
+  return options;
+}
+
+// Meshes and measures of one method from its raw marching-cubes mesh.
+void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const TriangleMesh& raw,
+                    const fusion::MeshingOptions& meshing, MethodResult& result) {
+  const auto start = SteadyClock::now();
+  fusion::MeshingResult meshes = fusion::MakeMeshes(raw, meshing);
+  result.measures["export_ms"] = MillisecondsSince(start);
+  result.measures["poisson_ms"] = meshes.poisson_ms;
+  const std::string object = c.object == "box" ? "" : c.object;
+  result.measures.update(eval::ReportScan(object, meshes.smoothed, meshes.watertight, gt_dir,
+                                          result.trajectory, nullptr));
+  result.seen = std::move(meshes.smoothed);
+  result.watertight = std::move(meshes.watertight);
+}
+
+}  // namespace
+
+CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
+                   const RunOptions& options) {
+  const fs::path dir = options.work / c.name;
+  GenerateIfNeeded(c, dir, options.quiet);
+  CaseResult out;
+  out.bench_case = c;
+  out.gt_dir = dir / "gt";
+  out.truth = ReadTumTrajectory(out.gt_dir / "trajectory.txt");
+  const std::vector<tracker::HandJointsRow> gt_joints =
+      tracker::ReadHandJointsCsv(out.gt_dir / "hand_joints.csv");
+
+  auto source = sensor::OpenInput((dir / "sequence.oni").string());
+  source->Start();
+  const CameraIntrinsics intrinsics = source->Intrinsics();
+  const app::ScannerOptions base;
+  app::HandStage hand(base, intrinsics);
+  std::vector<Runner> runners;
+  for (const Method& method : methods) {
+    Runner runner{method, OptionsFor(method), nullptr, nullptr};
+    runner.stage = std::make_unique<app::ObjectStage>(runner.options, intrinsics);
+    runner.record = std::make_unique<app::ScanRecord>(hand.BoneNames());
+    runners.push_back(std::move(runner));
+  }
+  std::unique_ptr<Open3dBaseline> open3d;
+  if (options.open3d && Open3dAvailable()) open3d = std::make_unique<Open3dBaseline>(intrinsics);
+
+  double joint_error_sum = 0, track_ms = 0, mask_ms = 0;
+  int frames = 0;
+  while (true) {
+    const sensor::SourceRead read = source->Next(std::chrono::seconds(5));
+    if (read.status == sensor::SourceStatus::kTimeout) continue;
+    if (read.status != sensor::SourceStatus::kFrame) break;
+    if (frames == 0 && c.init_from_gt) {
+      if (gt_joints.empty()) throw InputError(c.name + ": no ground-truth joints to start from");
+      hand.Initialise(tracker::FitPoseToJoints(hand.model(), gt_joints.front().joints_mm));
+    }
+    app::FramePacket packet;
+    packet.frame = read.frame;
+    hand.Process(packet);
+    track_ms += packet.track.milliseconds;
+    mask_ms += packet.mask_ms;
+    const std::int64_t index = read.frame->index;
+    if (!packet.track.joints_mm.empty() && index < static_cast<std::int64_t>(gt_joints.size())) {
+      const auto& truth = gt_joints[index].joints_mm;
+      double sum = 0;
+      for (size_t j = 0; j < packet.track.joints_mm.size() && j < truth.size(); ++j)
+        sum += (packet.track.joints_mm[j] - truth[j]).norm();
+      joint_error_sum += sum / packet.track.joints_mm.size();
+      ++out.tracked_frames;
+    }
+    for (Runner& runner : runners) {
+      app::FramePacket copy = packet;
+      runner.stage->Process(copy);
+      runner.record->Add(copy);
+    }
+    if (open3d) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(index));
+      const cv::Mat labels =
+          cv::imread((out.gt_dir / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
+      std::vector<std::uint8_t> keep(read.frame->PixelCount(), 0);
+      if (labels.total() == keep.size() && labels.isContinuous()) {
+        for (size_t i = 0; i < keep.size(); ++i) keep[i] = labels.data[i] == render::kObject;
+      }
+      open3d->Process(*read.frame, keep);
+    }
+    ++frames;
+    if (!options.quiet && frames % 200 == 0)
+      std::fprintf(stderr, "inhandscan-bench: %s frame %d\n", c.name.c_str(), frames);
+  }
+  if (frames == 0) throw InputError(c.name + ": no frames");
+  out.joint_error_mm = out.tracked_frames ? joint_error_sum / out.tracked_frames : 0;
+  out.track_ms = track_ms / frames;
+  out.mask_ms = mask_ms / frames;
+
+  for (Runner& runner : runners) {
+    MethodResult result;
+    result.method = runner.method.name;
+    result.frames = frames;
+    result.registered = static_cast<int>(runner.record->registered());
+    result.trajectory = runner.record->trajectory();
+    const nlohmann::json summary = runner.record->Summary();
+    result.measures["ms_per_frame"] = summary["ms_per_frame"];
+    result.measures["skip_reasons"] = summary.value("skip_reasons", nlohmann::json::object());
+    // The method's own log beside the sequence (per-frame status and reason, trajectory).
+    const fs::path method_dir = dir / runner.method.name;
+    fs::create_directories(method_dir);
+    runner.record->WriteTables(method_dir);
+    runner.record->WriteStats(method_dir / "stats.json", {{"method", runner.method.name}});
+    try {
+      if (result.trajectory.empty()) throw InputError("no frame was registered");
+      if (runner.method.sweep_only) {
+        const eval::PairwiseError pairwise =
+            eval::ContactPairwiseError(out.gt_dir, result.trajectory);
+        result.measures["pairwise_error_mm"] = {
+            {"mean", pairwise.mean_mm}, {"std", pairwise.std_mm}, {"samples", pairwise.samples}};
+        const eval::TrajectoryError drift = eval::CompareTrajectory(out.gt_dir, result.trajectory);
+        result.measures["trajectory_error_mm"] = {{"mean", drift.mean_mm}, {"max", drift.max_mm}};
+      } else {
+        const TriangleMesh raw = runner.stage->Snapshot();
+        runner.stage.reset();  // The volume's memory, before Poisson needs its own.
+        MeshAndMeasure(c, out.gt_dir, raw, runner.options.meshing, result);
+      }
+      result.ok = true;
+    } catch (const std::exception& error) {
+      result.error = error.what();
+    }
+    runner.stage.reset();
+    out.methods.push_back(std::move(result));
+  }
+
+  if (open3d) {
+    MethodResult result;
+    result.method = "open3d";
+    result.frames = frames;
+    try {
+      Open3dBaselineResult o3d = open3d->Finish();
+      open3d.reset();
+      result.registered = static_cast<int>(o3d.trajectory.size());
+      result.trajectory = std::move(o3d.trajectory);
+      result.measures["ms_per_frame"] = {{"odometry", o3d.odometry_ms},
+                                         {"integrate", o3d.integrate_ms},
+                                         {"fusion", o3d.odometry_ms + o3d.integrate_ms}};
+      result.measures["odometry_failures"] = o3d.odometry_failures;
+      if (result.trajectory.empty()) throw InputError("no frame was registered");
+      MeshAndMeasure(c, out.gt_dir, o3d.raw, base.meshing, result);
+      result.ok = true;
+    } catch (const std::exception& error) {
+      result.error = error.what();
+    }
+    out.methods.push_back(std::move(result));
+  }
+
+  if (!options.app.empty()) {
+    // The whole application on the same recording: frames per second and peak memory.
+    const fs::path app_out = dir / "app";
+    const std::string command = "'" + options.app.string() + "' replay '" +
+                                (dir / "sequence.oni").string() + "' --out '" + app_out.string() +
+                                "' --quiet > /dev/null 2>&1";
+    if (std::system(command.c_str()) == 0) {
+      std::ifstream stats(app_out / "stats.json");
+      const nlohmann::json json = nlohmann::json::parse(stats, nullptr, false);
+      if (!json.is_discarded() && json.contains("summary")) {
+        out.app_fps = json["summary"].value("frames_per_second", 0.0);
+        out.app_peak_mib = json["summary"].value("peak_rss_mib", 0.0);
+      }
+    } else if (!options.quiet) {
+      std::fprintf(stderr, "inhandscan-bench: %s: the application's replay failed\n",
+                   c.name.c_str());
+    }
+  }
+  return out;
+}
+
+}  // namespace ihs::bench
