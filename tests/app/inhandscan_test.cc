@@ -94,13 +94,16 @@ class InhandscanSignalTest : public ::testing::Test {
   }
   static void TearDownTestSuite() { delete dir_; }
 
-  // Replays at the recorded pace, sends `signal` after `seconds`, and waits for the exit.
+  // Replays at the recorded pace, sends `signal` `seconds` after the scan started (its output
+  // folder appears once the signal handlers are in place: a signal sent earlier, while a loaded
+  // machine is still starting the program, would find none), and waits for the exit.
   static test::CommandResult ReplayWithSignal(const fs::path& out, const std::string& signal,
                                               double seconds) {
-    const std::string command = std::string(IHS_APP) + " replay --realtime " +
-                                (*dir_ / "sequence.oni").string() + " --out " + out.string() +
-                                " --set pipeline.preview_every=0 & pid=$!; sleep " +
-                                std::to_string(seconds) + "; kill -" + signal + " $pid; wait $pid";
+    const std::string command =
+        std::string(IHS_APP) + " replay --realtime " + (*dir_ / "sequence.oni").string() +
+        " --out " + out.string() + " --set pipeline.preview_every=0 & pid=$!; i=0; while [ ! -d " +
+        out.string() + " ] && [ $i -lt 600 ]; do sleep 0.1; i=$((i+1)); done; sleep " +
+        std::to_string(seconds) + "; kill -" + signal + " $pid; wait $pid";
     return test::RunCommand("sh -c '" + command + "'");
   }
 
@@ -110,8 +113,9 @@ class InhandscanSignalTest : public ::testing::Test {
 test::TempDir* InhandscanSignalTest::dir_ = nullptr;
 
 TEST_F(InhandscanSignalTest, SigusrOneExportsAndTheReplayGoesOn) {
-  test::TempDir out;
-  const auto run = ReplayWithSignal(out.path(), "USR1", 1.5);
+  const test::TempDir dir;
+  const fs::path out = dir / "scan";  // Made by the program.
+  const auto run = ReplayWithSignal(out, "USR1", 1.5);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("export requested"), std::string::npos) << run.err;
   // The requested export and the final one.
@@ -150,8 +154,9 @@ TEST_F(InhandscanSignalTest, ReplayWritesEveryOutputAndTheFormatsAskedFor) {
 }
 
 TEST_F(InhandscanSignalTest, SigintFinishesExportsAndExitsZero) {
-  test::TempDir out;
-  const auto run = ReplayWithSignal(out.path(), "INT", 1.5);
+  const test::TempDir dir;
+  const fs::path out = dir / "scan";  // Made by the program.
+  const auto run = ReplayWithSignal(out, "INT", 1.5);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("mesh: "), std::string::npos) << run.out;
   const auto stats = nlohmann::json::parse(test::ReadFileString(out / "stats.json"));
