@@ -79,8 +79,11 @@ void HandStage::Process(FramePacket& packet) {
     packet.object_mask.assign(frame.depth_mm.size(), 0);
   }
   if (packet.track.HasPose()) {
-    auto hand = std::make_shared<TriangleMesh>(
-        tracker_.model().Pose(tracker::ForwardKinematics(tracker_.model(), packet.track.pose)));
+    std::shared_ptr<const TriangleMesh> hand = packet.track.posed_mesh;
+    if (!hand) {
+      hand = std::make_shared<const TriangleMesh>(
+          tracker_.model().Pose(tracker::ForwardKinematics(tracker_.model(), packet.track.pose)));
+    }
     packet.hand_pixels_removed =
         fusion::RemoveMeshPixels(*hand, frame, intrinsics_, options_.hand_dilation_px,
                                  options_.hand_depth_margin_mm, &packet.object_mask);

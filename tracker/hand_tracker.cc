@@ -279,7 +279,9 @@ TrackResult HandTracker::Track(const Frame& frame) {
   result.joints_mm = model_.JointPositions(cam_from_bone);
 
   // Contacts with the object's points, and those held since the previous frame.
-  const std::vector<Eigen::Vector3f> vertices = model_.Pose(cam_from_bone).vertices;
+  auto posed = std::make_shared<const TriangleMesh>(model_.Pose(cam_from_bone));
+  const std::vector<Eigen::Vector3f>& vertices = posed->vertices;
+  if (result.HasPose()) result.posed_mesh = posed;
   if (!result.segmentation.object_points.empty() && result.HasPose()) {
     // Only object points near the fingertips can touch them: those in the box around the
     // distal phalanges' bones, grown by a finger's radius and the largest contact threshold.

@@ -73,6 +73,9 @@ struct TrackResult {
   HandPose pose;
   /// The 21 joints (HandModel::JointPositions), camera frame, mm.
   std::vector<Eigen::Vector3d> joints_mm;
+  /// The template posed at `pose` (camera frame, mm) when the pose is usable, for whoever needs
+  /// the hand's surface next (the object mask) without posing it again.
+  std::shared_ptr<const TriangleMesh> posed_mesh;
   Contacts contacts;
   std::vector<ContactPair> contact_pairs;
   Segmentation segmentation;

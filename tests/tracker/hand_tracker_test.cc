@@ -36,6 +36,7 @@ TEST(HandTrackerTest, EmptyFramesAndFramesWithoutAHandAreSkippedWithAReason) {
   EXPECT_EQ(empty.status, TrackStatus::kEmptyFrame);
   EXPECT_EQ(empty.reason, "empty depth image");
   EXPECT_FALSE(empty.HasPose());
+  EXPECT_FALSE(empty.posed_mesh);
   // A blue square in the crop volume: an object, no hand.
   Frame frame = Frame::Blank(640, 480, true);
   for (int v = 200; v < 280; ++v) {
@@ -65,6 +66,13 @@ TEST(HandTrackerTest, TracksFromTheTruthAndFindsTheTouchingFingertips) {
     const synth::RenderedFrame rendered = renderer.Render(i);
     const TrackResult result = tracker.Track(rendered.frame);
     ASSERT_TRUE(result.HasPose()) << "frame " << i << ": " << result.reason;
+    // The posed template comes with the pose (the object mask uses it) and is the pose's.
+    ASSERT_TRUE(result.posed_mesh) << "frame " << i;
+    const TriangleMesh posed =
+        tracker.model().Pose(ForwardKinematics(tracker.model(), result.pose));
+    ASSERT_EQ(result.posed_mesh->vertices.size(), posed.vertices.size());
+    EXPECT_LT((result.posed_mesh->vertices.front() - posed.vertices.front()).norm(), 1e-4f);
+    EXPECT_LT((result.posed_mesh->vertices.back() - posed.vertices.back()).norm(), 1e-4f);
     error += MeanJointError(result.joints_mm, rendered.joints_mm);
     for (size_t e = 0; e < ends.size(); ++e) {
       const bool is = rendered.contact.fingertips[e].touching;
