@@ -12,4 +12,4 @@ build_dir="${IHS_BUILD_DIR:-build}"
 args=(--out "$root/docs")
 data="$root/../shared/data/hand-iccv15"
 [[ -d "$data/sequences" ]] && args+=(--data "$data")
-exec "$build_dir/tools/inhandscan-bench" "${args[@]}" "$@"
+IHS_BENCH_COMMAND="tools/bench.sh${*:+ $*}" exec "$build_dir/tools/inhandscan-bench" "${args[@]}" "$@"
