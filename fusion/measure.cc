@@ -197,13 +197,23 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
   return result;
 }
 
-std::vector<Eigen::Vector3f> SampleSurface(const TriangleMesh& mesh, double spacing_mm) {
+std::vector<Eigen::Vector3f> SampleSurface(const TriangleMesh& mesh, double spacing_mm,
+                                           std::size_t max_samples) {
   IHS_CHECK_ARG(spacing_mm > 0, "spacing_mm must be positive, got " << spacing_mm);
+  IHS_CHECK_ARG(max_samples > 0, "max_samples must be positive");
   std::mt19937 random(12345);
   std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
   std::vector<Eigen::Vector3f> samples;
+  double area = 0;
+  for (const auto& f : mesh.faces) {
+    area += 0.5 * (mesh.vertices[f[1]] - mesh.vertices[f[0]])
+                      .cross(mesh.vertices[f[2]] - mesh.vertices[f[0]])
+                      .norm();
+  }
+  const double per_mm2 =
+      std::min(1.0 / (spacing_mm * spacing_mm), static_cast<double>(max_samples) / area);
+  samples.reserve(static_cast<std::size_t>(area * per_mm2) + 1);
   double carry = 0;
-  const double per_mm2 = 1.0 / (spacing_mm * spacing_mm);
   for (const auto& f : mesh.faces) {
     const Eigen::Vector3f a = mesh.vertices[f[0]], b = mesh.vertices[f[1]], c = mesh.vertices[f[2]];
     carry += 0.5 * (b - a).cross(c - a).norm() * per_mm2;

@@ -58,7 +58,9 @@ SurfaceComparison CompareSurfaces(const TriangleMesh& scan, const TriangleMesh& 
                                   double within_mm = 2.0, double spacing_mm = 0.25);
 
 /// Points spread over the surface of `mesh`, one per `spacing_mm`² of area on average
-/// (deterministic).
-std::vector<Eigen::Vector3f> SampleSurface(const TriangleMesh& mesh, double spacing_mm);
+/// (deterministic), but at most about `max_samples`: a larger surface (a scan that lost the object
+/// and smeared it over metres) is sampled more sparsely instead of filling the memory.
+std::vector<Eigen::Vector3f> SampleSurface(const TriangleMesh& mesh, double spacing_mm,
+                                           std::size_t max_samples = 4'000'000);
 
 }  // namespace ihs::fusion

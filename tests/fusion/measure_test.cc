@@ -93,3 +93,29 @@ TEST(MeasureTest, SurfaceComparisonMeasuresTheGapAndTheCoverage) {
 
 }  // namespace
 }  // namespace ihs::fusion
+
+namespace ihs::fusion {
+namespace {
+
+// A flat square of `side` mm, two triangles.
+TriangleMesh Square(float side) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {side, 0, 0}, {side, side, 0}, {0, side, 0}};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  return mesh;
+}
+
+TEST(SampleSurfaceTest, SamplesByAreaButNeverBeyondTheCap) {
+  // 10 × 10 mm at 0.25 mm: 1600 samples.
+  EXPECT_NEAR(SampleSurface(Square(10), 0.25).size(), 1600.0, 2.0);
+  // A smeared scan of 2 m × 2 m would need 64 million: it gets the cap instead, spread evenly.
+  const std::vector<Eigen::Vector3f> big = SampleSurface(Square(2000), 0.25, 20000);
+  EXPECT_NEAR(big.size(), 20000.0, 2.0);
+  int far_half = 0;
+  for (const auto& p : big) far_half += p.x() > 1000;
+  EXPECT_NEAR(far_half, 10000, 500);
+  EXPECT_TRUE(SampleSurface(TriangleMesh(), 0.25).empty());
+}
+
+}  // namespace
+}  // namespace ihs::fusion
