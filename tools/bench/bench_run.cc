@@ -1,7 +1,5 @@
 #include "tools/bench/bench_run.h"
 
-#include <spdlog/spdlog.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -9,7 +7,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include "app/scan_export.h"
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
 #include "core/errors.h"
@@ -29,12 +26,14 @@ namespace fs = std::filesystem;
 std::vector<double> GammaSweep() { return {0, 1, 5, 10, 15, 20, 30}; }
 
 std::vector<Method> DefaultMethods(const std::vector<double>& sweep) {
-  std::vector<Method> methods = {{"ours", 15, true, true, false},
+  // Ours is the scanner's default contact weight (the paper's γt).
+  const double ours = app::ScannerOptions().fusion.pairwise.contact_weight;
+  std::vector<Method> methods = {{"ours", ours, true, true, false},
                                  {"visual-only", 0, true, true, false},
-                                 {"contacts-only", 15, false, true, false},
-                                 {"no-icp", 15, true, false, false}};
+                                 {"contacts-only", ours, false, true, false},
+                                 {"no-icp", ours, true, false, false}};
   for (double gamma : sweep) {
-    if (gamma == 0 || gamma == 15) continue;  // Visual only and ours.
+    if (gamma == 0 || gamma == ours) continue;  // Visual only and ours.
     char name[32];
     std::snprintf(name, sizeof name, "gamma-%g", gamma);
     methods.push_back({name, gamma, true, true, true});
