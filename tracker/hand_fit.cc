@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "core/check.h"
+#include "core/point_kd_tree.h"
 #include "core/rigid_fit.h"
 #include "tracker/hand_fit_cost.h"
-#include "core/point_kd_tree.h"
 
 namespace ihs::tracker {
 namespace {
@@ -48,33 +48,49 @@ std::vector<int> NearestSetPixels(const std::vector<std::uint8_t>& mask, int wid
                                   const std::array<int, 4>& roi) {
   const auto [x0, y0, x1, y1] = roi;
   const int w = x1 - x0, h = y1 - y0;
-  std::vector<int> site(static_cast<size_t>(w) * h, -1);
-  std::vector<double> distance(site.size(), std::numeric_limits<double>::infinity());
+  // Per ROI pixel: its current site's ROI coordinates (−1: none yet) and squared distance.
+  struct Site {
+    int x = -1, y = -1, d2 = std::numeric_limits<int>::max();
+  };
+  std::vector<Site> sites(static_cast<size_t>(w) * h);
   for (int y = 0; y < h; ++y) {
+    const std::uint8_t* row = &mask[static_cast<size_t>(y + y0) * width + x0];
     for (int x = 0; x < w; ++x) {
-      const int pixel = (y + y0) * width + x + x0;
-      if (mask[pixel]) site[y * w + x] = pixel, distance[y * w + x] = 0;
+      if (row[x]) sites[static_cast<size_t>(y) * w + x] = {x, y, 0};
     }
   }
-  auto relax = [&](int x, int y, int nx, int ny) {
-    if (nx < 0 || ny < 0 || nx >= w || ny >= h) return;
-    const int candidate = site[ny * w + nx];
-    if (candidate < 0) return;
-    const double dx = candidate % width - (x + x0), dy = candidate / width - (y + y0);
-    const double d = dx * dx + dy * dy;
-    if (d < distance[y * w + x]) distance[y * w + x] = d, site[y * w + x] = candidate;
+  auto relax = [&](Site& here, int x, int y, const Site& from) {
+    if (from.x < 0) return;
+    const int dx = from.x - x, dy = from.y - y, d2 = dx * dx + dy * dy;
+    if (d2 < here.d2) here = {from.x, from.y, d2};
   };
   for (int y = 0; y < h; ++y) {
+    Site* row = &sites[static_cast<size_t>(y) * w];
+    const Site* up = y > 0 ? row - w : nullptr;
     for (int x = 0; x < w; ++x) {
-      relax(x, y, x - 1, y), relax(x, y, x - 1, y - 1), relax(x, y, x, y - 1);
-      relax(x, y, x + 1, y - 1);
+      if (x > 0) relax(row[x], x, y, row[x - 1]);
+      if (up) {
+        if (x > 0) relax(row[x], x, y, up[x - 1]);
+        relax(row[x], x, y, up[x]);
+        if (x + 1 < w) relax(row[x], x, y, up[x + 1]);
+      }
     }
   }
   for (int y = h - 1; y >= 0; --y) {
+    Site* row = &sites[static_cast<size_t>(y) * w];
+    const Site* down = y + 1 < h ? row + w : nullptr;
     for (int x = w - 1; x >= 0; --x) {
-      relax(x, y, x + 1, y), relax(x, y, x + 1, y + 1), relax(x, y, x, y + 1);
-      relax(x, y, x - 1, y + 1);
+      if (x + 1 < w) relax(row[x], x, y, row[x + 1]);
+      if (down) {
+        if (x + 1 < w) relax(row[x], x, y, down[x + 1]);
+        relax(row[x], x, y, down[x]);
+        if (x > 0) relax(row[x], x, y, down[x - 1]);
+      }
     }
+  }
+  std::vector<int> site(sites.size(), -1);
+  for (size_t i = 0; i < sites.size(); ++i) {
+    if (sites[i].x >= 0) site[i] = (sites[i].y + y0) * width + sites[i].x + x0;
   }
   return site;
 }
@@ -98,7 +114,9 @@ HandFitCost::HandFitCost(const HandModel& model, const Eigen::Matrix3d& referenc
   IHS_CHECK(prior_.size() == dofs_.size(),
             "prior has " << prior_.size() << " angles, the model " << dofs_.size());
   const int n = derivatives_.size();
-  set_num_residuals(static_cast<int>(3 * terms_.points.size() + terms_.planes.size() +
+  size_t plane_rows = 0;
+  for (const PlanePair& pair : terms_.planes) plane_rows += pair.point_weight > 0 ? 3 : 1;
+  set_num_residuals(static_cast<int>(3 * terms_.points.size() + plane_rows +
                                      2 * terms_.silhouette.size() + terms_.collisions.size() +
                                      2 * dofs_.size()));
   mutable_parameter_block_sizes()->push_back(n);
@@ -130,15 +148,34 @@ bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
   }
   for (const PlanePair& pair : terms_.planes) {
     const Eigen::Vector3d p = skinned(pair.vertex);
-    residuals[row] = pair.weight * pair.normal.dot(p - pair.target);
+    const Eigen::Vector3d& normal = pair.normal;
+    if (pair.point_weight <= 0) {
+      residuals[row] = pair.weight * normal.dot(p - pair.target);
+      if (jacobian) {
+        for (int c = 0; c < n; ++c) {
+          double d = 0;
+          for (int r = 0; r < 3; ++r) d += normal[r] * point_jacobian[r * n + c];
+          jacobian[row * n + c] = pair.weight * d;
+        }
+      }
+      ++row;
+      continue;
+    }
+    // A = p·I + b·n·nᵀ, b = √(p² + w²) − p: normal component weighted √(p² + w²), tangential p.
+    const double a = pair.point_weight;
+    const double b = std::sqrt(a * a + pair.weight * pair.weight) - a;
+    const Eigen::Vector3d residual =
+        a * (p - pair.target) + b * normal.dot(p - pair.target) * normal;
+    for (int r = 0; r < 3; ++r) residuals[row + r] = residual[r];
     if (jacobian) {
       for (int c = 0; c < n; ++c) {
-        double d = 0;
-        for (int r = 0; r < 3; ++r) d += pair.normal[r] * point_jacobian[r * n + c];
-        jacobian[row * n + c] = pair.weight * d;
+        const Eigen::Vector3d column(point_jacobian[c], point_jacobian[n + c],
+                                     point_jacobian[2 * n + c]);
+        const Eigen::Vector3d d = a * column + b * normal.dot(column) * normal;
+        for (int r = 0; r < 3; ++r) jacobian[(row + r) * n + c] = d[r];
       }
     }
-    ++row;
+    row += 3;
   }
   for (const SilhouettePair& pair : terms_.silhouette) {
     const Eigen::Vector3d p = skinned(pair.vertex);
@@ -463,11 +500,7 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     const double data_scale = data_pairs.empty() ? 0 : 1.0 / std::sqrt(double(data_pairs.size()));
     for (PlanePair& pair : data_pairs) pair.weight *= data_scale;
     // The data → model pairs also as points: a plane lets a finger slide along its axis.
-    if (options_.data_point_weight > 0) {
-      for (const PlanePair& pair : data_pairs) {
-        model_pairs.push_back({pair.vertex, pair.target, options_.data_point_weight * pair.weight});
-      }
-    }
+    for (PlanePair& pair : data_pairs) pair.point_weight = options_.data_point_weight * pair.weight;
 
     // Collisions between capsules of different fingers that are close now.
     std::vector<CollisionPair> collisions;

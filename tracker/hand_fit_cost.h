@@ -21,12 +21,14 @@ struct PointPair {
 };
 
 /// A model vertex that should lie on the plane through `target` with unit `normal` (camera
-/// frame), weighted: a point-to-plane pair.
+/// frame), weighted: a point-to-plane pair. With `point_weight` > 0 the same vertex is also
+/// pulled to `target` itself; both terms then share one three-row residual (see HandFitCost).
 struct PlanePair {
   int vertex = 0;
   Eigen::Vector3d target;
   Eigen::Vector3d normal;
   double weight = 1.0;
+  double point_weight = 0.0;
 };
 
 /// A model vertex whose image should lie at pixel `target` (the nearest pixel of the observed
@@ -56,7 +58,9 @@ struct HandFitTerms {
   std::vector<CollisionPair> collisions;
 };
 
-/// Residuals: for each point pair w·(x_v − target) (3), for each plane pair w·n·(x_v − target),
+/// Residuals: for each point pair w·(x_v − target) (3), for each plane pair w·n·(x_v − target)
+/// (1) or, with a point weight p, A·(x_v − target) with A = p·I + (√(p² + w²) − p)·n·nᵀ (3: its
+/// square is exactly w²(n·d)² + p²|d|², a plane pair plus a point pair of the same vertex),
 /// for each silhouette pair w·(π(x_v) − target) (2, π the camera's projection), for each
 /// collision √γc·max(0, r_a + r_b − |A − B|), for each joint angle the soft limit excess
 /// (limit_weight per rad) and the pull toward `prior_rad` (prior_weight per rad). One parameter

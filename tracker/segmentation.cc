@@ -12,8 +12,9 @@ namespace {
 
 enum Class : std::uint8_t { kNone = 0, kSkin = 1, kOther = 2 };
 
-// Labels 4-connected regions of equal class whose neighbouring depths differ by at most
-// `max_step_mm`; returns the region of each pixel (−1 for kNone) and fills `sizes`.
+// Labels 4-connected regions of equal class in a width × height image whose neighbouring depths
+// differ by at most `max_step_mm`; returns the region of each pixel (−1 for kNone) and fills
+// `sizes`.
 std::vector<int> Regions(const std::vector<std::uint8_t>& classes,
                          const std::vector<std::uint16_t>& depth, int width, int height,
                          double max_step_mm, std::vector<int>* sizes) {
@@ -82,77 +83,95 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
   out.hand_mask.assign(n, 0);
   out.object_mask.assign(n, 0);
 
-  // Classify cropped pixels by colour.
-  std::vector<std::uint8_t> classes(n, kNone);
-  std::vector<Eigen::Vector3f> points(n);
+  // The box around the pixels inside the crop volume; everything after works in it.
+  auto in_crop = [&](int u, int v, std::uint16_t z) {
+    if (z == 0 || z < options_.crop_min_mm.z() || z > options_.crop_max_mm.z()) return false;
+    const Eigen::Vector3d x = intrinsics_.BackProject(u, v, z);
+    return (x.array() >= options_.crop_min_mm.array()).all() &&
+           (x.array() <= options_.crop_max_mm.array()).all();
+  };
+  int u0 = w, v0 = h, u1 = 0, v1 = 0;
   for (int v = 0; v < h; ++v) {
+    const std::uint16_t* row = &frame.depth_mm[static_cast<size_t>(v) * w];
     for (int u = 0; u < w; ++u) {
-      const size_t p = static_cast<size_t>(v) * w + u;
-      const std::uint16_t z = frame.depth_mm[p];
-      if (z == 0) continue;
-      const Eigen::Vector3d x = intrinsics_.BackProject(u, v, z);
-      if ((x.array() < options_.crop_min_mm.array()).any() ||
-          (x.array() > options_.crop_max_mm.array()).any()) {
-        continue;
-      }
-      ++out.cropped_pixels;
-      points[p] = x.cast<float>();
-      bool skin = false;
-      if (frame.HasColor()) {
-        const std::uint8_t* c = &frame.rgb[3 * p];
-        skin = skin_->LogLikelihoodRatio(c[0], c[1], c[2]) > options_.skin_log_ratio;
-      }
-      classes[p] = skin ? kSkin : kOther;
+      if (!in_crop(u, v, row[u])) continue;
+      u0 = std::min(u0, u), v0 = std::min(v0, v), u1 = std::max(u1, u + 1), v1 = v + 1;
     }
+  }
+  if (u1 <= u0) return out;
+  const int bw = u1 - u0, bh = v1 - v0;
+  const size_t bn = static_cast<size_t>(bw) * bh;
+  // Box index → image index, and the 3D point of a box pixel.
+  auto image_index = [&](size_t i) {
+    return static_cast<size_t>(static_cast<int>(i / bw) + v0) * w + static_cast<int>(i % bw) + u0;
+  };
+  std::vector<std::uint16_t> depth(bn);
+  for (size_t i = 0; i < bn; ++i) depth[i] = frame.depth_mm[image_index(i)];
+  auto point = [&](size_t i) {
+    return intrinsics_.BackProject(static_cast<int>(i % bw) + u0, static_cast<int>(i / bw) + v0,
+                                   depth[i]);
+  };
+
+  // Classify cropped pixels by colour.
+  std::vector<std::uint8_t> classes(bn, kNone);
+  for (size_t i = 0; i < bn; ++i) {
+    if (!in_crop(static_cast<int>(i % bw) + u0, static_cast<int>(i / bw) + v0, depth[i])) continue;
+    ++out.cropped_pixels;
+    bool skin = false;
+    if (frame.HasColor()) {
+      const std::uint8_t* c = &frame.rgb[3 * image_index(i)];
+      skin = skin_->LogLikelihoodRatio(c[0], c[1], c[2]) > options_.skin_log_ratio;
+    }
+    classes[i] = skin ? kSkin : kOther;
   }
 
   // Depth-connected regions; small ones go.
   std::vector<int> sizes;
   const std::vector<int> region =
-      Regions(classes, frame.depth_mm, w, h, options_.connect_depth_mm, &sizes);
+      Regions(classes, depth, bw, bh, options_.connect_depth_mm, &sizes);
+  std::vector<std::uint8_t> hand(bn, 0);
   Eigen::Vector3d hand_sum = Eigen::Vector3d::Zero();
   int hand_count = 0;
-  for (size_t p = 0; p < n; ++p) {
-    if (classes[p] != kSkin || sizes[region[p]] < options_.min_region_pixels) continue;
-    out.hand_mask[p] = 1;
-    hand_sum += points[p].cast<double>();
+  for (size_t i = 0; i < bn; ++i) {
+    if (classes[i] != kSkin || sizes[region[i]] < options_.min_region_pixels) continue;
+    hand[i] = 1;
+    hand_sum += point(i);
     ++hand_count;
   }
 
   // Object regions: not skin, not touching the hand's boundary band, near the hand.
-  std::vector<std::uint8_t> near_hand(n, 0);
+  std::vector<std::uint8_t> near_hand(bn, 0);
   const int r = options_.boundary_px;
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      if (!out.hand_mask[static_cast<size_t>(v) * w + u]) continue;
-      for (int dv = -r; dv <= r; ++dv) {
-        for (int du = -r; du <= r; ++du) {
-          const int uu = u + du, vv = v + dv;
-          if (uu >= 0 && uu < w && vv >= 0 && vv < h)
-            near_hand[static_cast<size_t>(vv) * w + uu] = 1;
-        }
+  for (int v = 0; v < bh; ++v) {
+    for (int u = 0; u < bw; ++u) {
+      if (!hand[static_cast<size_t>(v) * bw + u]) continue;
+      for (int vv = std::max(0, v - r); vv <= std::min(bh - 1, v + r); ++vv) {
+        for (int uu = std::max(0, u - r); uu <= std::min(bw - 1, u + r); ++uu)
+          near_hand[static_cast<size_t>(vv) * bw + uu] = 1;
       }
     }
   }
   std::vector<Eigen::Vector3d> region_sum(sizes.size(), Eigen::Vector3d::Zero());
-  for (size_t p = 0; p < n; ++p) {
-    if (classes[p] == kOther) region_sum[region[p]] += points[p].cast<double>();
+  for (size_t i = 0; i < bn; ++i) {
+    if (classes[i] == kOther) region_sum[region[i]] += point(i);
   }
   const Eigen::Vector3d hand_centre =
       hand_count > 0 ? Eigen::Vector3d(hand_sum / hand_count) : Eigen::Vector3d::Zero();
-  for (size_t p = 0; p < n; ++p) {
-    if (classes[p] != kOther || near_hand[p]) continue;
-    const int id = region[p];
+  for (size_t i = 0; i < bn; ++i) {
+    if (hand[i]) {
+      out.hand_mask[image_index(i)] = 1;
+      out.hand_points.push_back(point(i).cast<float>());
+      continue;
+    }
+    if (classes[i] != kOther || near_hand[i]) continue;
+    const int id = region[i];
     if (sizes[id] < options_.min_region_pixels) continue;
     if (hand_count > 0 &&
         (region_sum[id] / sizes[id] - hand_centre).norm() > options_.max_object_distance_mm) {
       continue;
     }
-    out.object_mask[p] = 1;
-  }
-  for (size_t p = 0; p < n; ++p) {
-    if (out.hand_mask[p]) out.hand_points.push_back(points[p]);
-    if (out.object_mask[p]) out.object_points.push_back(points[p]);
+    out.object_mask[image_index(i)] = 1;
+    out.object_points.push_back(point(i).cast<float>());
   }
   return out;
 }

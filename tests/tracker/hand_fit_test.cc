@@ -48,8 +48,10 @@ void CheckGradients(const HandModel& model, std::mt19937& rng) {
   }
   std::vector<PlanePair> planes;
   for (int i = 0; i < 30; ++i) {
+    // Every other one also a point pair of the same vertex (the three-row form).
     planes.push_back({vertex(rng), Eigen::Vector3d(unit(rng) * 80, unit(rng) * 80, 600),
-                      Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized(), 0.7});
+                      Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized(), 0.7,
+                      i % 2 ? 1.3 : 0.0});
   }
   // Index and middle distal phalanges forced to overlap (radii larger than their distance).
   const int index = model.BoneIndex("RFing.3_2"), middle = model.BoneIndex("RFing.2_2");
@@ -97,6 +99,45 @@ void CheckGradients(const HandModel& model, std::mt19937& rng) {
     }
   }
   EXPECT_EQ(bad, 0);
+}
+
+// A plane pair with a point weight costs exactly what the plane pair and a separate point pair
+// of the same vertex cost together.
+TEST(HandFitCostTest, PlanePairWithPointWeightCostsAsPlanePlusPointPair) {
+  std::mt19937 rng = test::Rng();
+  const HandModel model = MakeProceduralHand();
+  const PoseParameters parameters(RandomPose(model, rng));
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::uniform_int_distribution<int> vertex(0,
+                                            static_cast<int>(model.rest_mesh.vertices.size()) - 1);
+  std::vector<PlanePair> merged;
+  std::vector<PlanePair> planes;
+  std::vector<PointPair> points;
+  for (int i = 0; i < 25; ++i) {
+    const PlanePair plane{vertex(rng), Eigen::Vector3d(unit(rng) * 80, unit(rng) * 80, 600),
+                          Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized(),
+                          0.2 + std::abs(unit(rng)), 0.0};
+    planes.push_back(plane);
+    merged.push_back(plane);
+    merged.back().point_weight = 0.1 + 2 * std::abs(unit(rng));
+    points.push_back({plane.vertex, plane.target, merged.back().point_weight});
+  }
+  const std::vector<double> prior(parameters.values().size() - 6, 0.0);
+  auto cost_of = [&](HandFitTerms terms) {
+    const HandFitCost cost(model, parameters.reference_rotation(), CameraIntrinsics::Carmine109(),
+                           std::move(terms), 10.0, 0.0, 0.0, prior);
+    std::vector<double> residuals(cost.num_residuals());
+    const double* blocks[] = {parameters.values().data()};
+    EXPECT_TRUE(cost.Evaluate(blocks, residuals.data(), nullptr));
+    double sum = 0;
+    for (double r : residuals) sum += r * r;
+    return std::make_pair(sum, cost.num_residuals());
+  };
+  const auto [merged_cost, merged_rows] = cost_of({{}, merged, {}, {}});
+  const auto [separate_cost, separate_rows] = cost_of({points, planes, {}, {}});
+  EXPECT_GT(separate_cost, 1.0);
+  EXPECT_NEAR(merged_cost, separate_cost, 1e-9 * separate_cost);
+  EXPECT_EQ(separate_rows - merged_rows, 25);  // One row per pair saved.
 }
 
 TEST(HandFitCostTest, AnalyticDerivativesMatchNumericOnesOnTheProceduralHand) {
