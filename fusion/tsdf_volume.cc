@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -15,6 +16,9 @@ namespace ihs::fusion {
 namespace {
 
 constexpr float kTsdfScale = 32767.0f;
+
+// The nearest integer, halves away from zero: std::lround without its library call.
+inline int RoundToInt(float x) { return static_cast<int>(x >= 0 ? x + 0.5f : x - 0.5f); }
 
 // Cell corners (as offsets) and edges (as corner pairs) in the order of the case tables.
 constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
@@ -72,7 +76,8 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
 
   // The voxels within the band around each observed pixel's surface point, along its ray.
   const int samples = static_cast<int>(std::floor(2.0f * band / (0.5f * voxel))) + 1;
-  std::vector<std::int64_t> touched;
+  // Each voxel once: a bit per voxel, set here and cleared again below.
+  std::int64_t first_word = static_cast<std::int64_t>(touched_bits_.size()), last_word = -1;
   for (int v = 0; v < frame.height; ++v) {
     for (int u = 0; u < frame.width; ++u) {
       const int pixel = v * frame.width + u;
@@ -85,21 +90,19 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
       Eigen::Vector3f grid =
           ((rotation * (point - band * ray) + translation).array() + half) / voxel;
       for (int s = 0; s < samples; ++s, grid += step) {
-        const int i = static_cast<int>(std::floor(grid.x()));
-        const int j = static_cast<int>(std::floor(grid.y()));
-        const int k = static_cast<int>(std::floor(grid.z()));
-        if (i < 0 || j < 0 || k < 0 || i >= n_ || j >= n_ || k >= n_) continue;
+        // Inside the cube the coordinates are non-negative: truncation is their floor.
+        if (!(grid.x() >= 0 && grid.y() >= 0 && grid.z() >= 0)) continue;
+        const int i = static_cast<int>(grid.x());
+        const int j = static_cast<int>(grid.y());
+        const int k = static_cast<int>(grid.z());
+        if (i >= n_ || j >= n_ || k >= n_) continue;
         const std::int64_t index = Index(i, j, k);
-        // Each voxel once: a bit per voxel, set here and cleared again below.
-        std::uint64_t& word = touched_bits_[index >> 6];
-        const std::uint64_t bit = std::uint64_t{1} << (index & 63);
-        if (word & bit) continue;
-        word |= bit;
-        touched.push_back(index);
+        touched_bits_[index >> 6] |= std::uint64_t{1} << (index & 63);
+        first_word = std::min(first_word, index >> 6);
+        last_word = std::max(last_word, index >> 6);
       }
     }
   }
-  for (const std::int64_t index : touched) touched_bits_[index >> 6] = 0;
 
   // Projective update of each: the distance along the ray from the voxel to the surface seen
   // through its pixel.
@@ -107,32 +110,35 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   const Eigen::Vector3f cam_translation = cam_from_volume.translation().cast<float>();
   const bool color = options_.color && frame.HasColor();
   int updated = 0;
-  for (const std::int64_t index : touched) {
+  // In memory order (the bits' order), which the caches like far better than the rays' order.
+  auto update = [&](std::int64_t index) {
     const int i = static_cast<int>(index % n_), j = static_cast<int>((index / n_) % n_),
               k = static_cast<int>(index / (static_cast<std::int64_t>(n_) * n_));
     const Eigen::Vector3f centre = cam_rotation * Centre(i, j, k) + cam_translation;
-    if (centre.z() <= 0) continue;
+    if (centre.z() <= 0) return;
     const float x = static_cast<float>(intrinsics.fx) * centre.x() / centre.z() +
                     static_cast<float>(intrinsics.cx);
     const float y = static_cast<float>(intrinsics.fy) * centre.y() / centre.z() +
                     static_cast<float>(intrinsics.cy);
-    const int u = static_cast<int>(std::lround(x)), v = static_cast<int>(std::lround(y));
-    if (u < 0 || v < 0 || u >= frame.width || v >= frame.height) continue;
+    // The nearest pixel (x, y ≥ −0.5 inside the image: truncation rounds there).
+    if (!(x >= -0.5f && y >= -0.5f)) return;
+    const int u = static_cast<int>(x + 0.5f), v = static_cast<int>(y + 0.5f);
+    if (u >= frame.width || v >= frame.height) return;
     const int pixel = v * frame.width + u;
-    if (!observed(pixel)) continue;
+    if (!observed(pixel)) return;
     const float along_ray = std::sqrt(centre.squaredNorm()) / centre.z();
     const float distance = (frame.depth_mm[pixel] - centre.z()) * along_ray;
-    if (distance < -band) continue;  // Behind the surface: not seen.
+    if (distance < -band) return;  // Behind the surface: not seen.
     const float tsdf = std::min(1.0f, distance / band);
     Voxel& voxel_ref = voxels_[index];
     const float weight = voxel_ref.weight;
     const float mean = (voxel_ref.tsdf / kTsdfScale * weight + tsdf) / (weight + 1);
-    voxel_ref.tsdf = static_cast<std::int16_t>(std::lround(mean * kTsdfScale));
+    voxel_ref.tsdf = static_cast<std::int16_t>(RoundToInt(mean * kTsdfScale));
     if (color && std::abs(distance) < band) {
       for (int c = 0; c < 3; ++c) {
         const float value = frame.rgb[3 * pixel + c];
         voxel_ref.rgb[c] = static_cast<std::uint8_t>(
-            std::lround((voxel_ref.rgb[c] * weight + value) / (weight + 1)));
+            RoundToInt((voxel_ref.rgb[c] * weight + value) / (weight + 1)));
       }
     }
     voxel_ref.weight =
@@ -143,6 +149,12 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
       observed_hi_[a] = std::max(observed_hi_[a], ijk[a]);
     }
     ++updated;
+  };
+  for (std::int64_t w = first_word; w <= last_word; ++w) {
+    std::uint64_t bits = touched_bits_[w];
+    if (bits == 0) continue;
+    touched_bits_[w] = 0;
+    for (; bits != 0; bits &= bits - 1) update(w * 64 + std::countr_zero(bits));
   }
   return updated;
 }
@@ -150,20 +162,26 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
 bool TsdfVolume::SignedDistance(const Eigen::Vector3f& point, float* distance_mm) const {
   const float half = static_cast<float>(0.5 * options_.size_mm);
   const Eigen::Vector3f grid = (point.array() + half) / static_cast<float>(voxel_mm_) - 0.5f;
-  const int i = static_cast<int>(std::floor(grid.x()));
-  const int j = static_cast<int>(std::floor(grid.y()));
-  const int k = static_cast<int>(std::floor(grid.z()));
-  if (i < 0 || j < 0 || k < 0 || i + 1 >= n_ || j + 1 >= n_ || k + 1 >= n_) return false;
+  // Outside the cube (also catches NaN): the comparisons are false.
+  if (!(grid.x() >= 0 && grid.y() >= 0 && grid.z() >= 0)) return false;
+  const int i = static_cast<int>(grid.x()), j = static_cast<int>(grid.y()),
+            k = static_cast<int>(grid.z());
+  if (i + 1 >= n_ || j + 1 >= n_ || k + 1 >= n_) return false;
   const float fx = grid.x() - i, fy = grid.y() - j, fz = grid.z() - k;
-  float sum = 0;
-  for (int c = 0; c < 8; ++c) {
-    const Voxel& voxel = voxels_[Index(i + kCorner[c][0], j + kCorner[c][1], k + kCorner[c][2])];
-    if (voxel.weight == 0) return false;
-    const float w = (kCorner[c][0] ? fx : 1 - fx) * (kCorner[c][1] ? fy : 1 - fy) *
-                    (kCorner[c][2] ? fz : 1 - fz);
-    sum += w * voxel.tsdf;
+  // The cell's corners: x fastest, then y, then z.
+  const std::int64_t row = n_, slice = static_cast<std::int64_t>(n_) * n_;
+  const Voxel* base = &voxels_[Index(i, j, k)];
+  const Voxel* c[8] = {base,         base + 1,         base + row,         base + row + 1,
+                       base + slice, base + slice + 1, base + slice + row, base + slice + row + 1};
+  float value[8];
+  for (int q = 0; q < 8; ++q) {
+    if (c[q]->weight == 0) return false;
+    value[q] = c[q]->tsdf;
   }
-  *distance_mm = sum / kTsdfScale * static_cast<float>(truncation_mm_);
+  auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
+  const float y0 = lerp(lerp(value[0], value[1], fx), lerp(value[2], value[3], fx), fy);
+  const float y1 = lerp(lerp(value[4], value[5], fx), lerp(value[6], value[7], fx), fy);
+  *distance_mm = lerp(y0, y1, fz) * (static_cast<float>(truncation_mm_) / kTsdfScale);
   return true;
 }
 
