@@ -52,9 +52,10 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       const Eigen::Vector3d p = correction * Eigen::Vector3d(point.cast<double>());
       if (p.z() <= 0) continue;
       const Eigen::Vector2d pixel = intrinsics.Project(p);
-      const int u = static_cast<int>(std::lround(pixel.x()));
-      const int v = static_cast<int>(std::lround(pixel.y()));
-      if (u < 0 || v < 0 || u >= model.width || v >= model.height) continue;
+      // The nearest pixel (truncation rounds for coordinates ≥ −0.5).
+      if (!(pixel.x() >= -0.5 && pixel.y() >= -0.5)) continue;
+      const int u = static_cast<int>(pixel.x() + 0.5), v = static_cast<int>(pixel.y() + 0.5);
+      if (u >= model.width || v >= model.height) continue;
       const size_t index = static_cast<size_t>(v) * model.width + u;
       const float depth = model.depth_mm[index];
       const Eigen::Vector3d normal = model.normals[index].cast<double>();
@@ -65,11 +66,13 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       // d(residual)/d(θ, t) for p ← exp(θ / scale)·(p − c) + c + t: ((p − c) / scale × n, n).
       Eigen::Matrix<double, 6, 1> row;
       row << ((p - centre) / scale).cross(normal), normal;
-      normal_matrix += row * row.transpose();
+      // The upper triangle only; the lower one is filled in once per iteration.
+      for (int c = 0; c < 6; ++c) normal_matrix.col(c).head(c + 1) += row[c] * row.head(c + 1);
       rhs -= row * residual;
       sum_sq += residual * residual;
       ++inliers;
     }
+    normal_matrix.triangularView<Eigen::StrictlyLower>() = normal_matrix.transpose();
     rms = inliers > 0 ? std::sqrt(sum_sq / inliers) : 0;
     // The anchors together weigh `anchor_share` of the surface's pairs: they decide what the
     // surface leaves open (a sphere's turn) and hardly move what it fixes.
