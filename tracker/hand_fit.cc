@@ -232,6 +232,8 @@ void HandFitOptions::Check() const {
   IHS_CHECK_ARG(collision_weight >= 0, "hand_fit.collision_weight must be >= 0");
   IHS_CHECK_ARG(outer_iterations >= 1 && inner_iterations >= 1,
                 "hand_fit.outer_iterations and inner_iterations must be >= 1");
+  IHS_CHECK_ARG(inner_function_tolerance > 0 && inner_function_tolerance < 1,
+                "hand_fit.inner_function_tolerance must be in (0, 1)");
   IHS_CHECK_ARG(max_data_points >= 10 && max_model_points >= 10,
                 "hand_fit.max_data_points and max_model_points must be >= 10");
   IHS_CHECK_ARG(max_correspondence_mm > 0 && robust_scale_mm > 0,
@@ -532,6 +534,7 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     // A few hundred residual rows, ≈ 30 parameters: the normal equations are small and cheap.
     solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
     solver.max_num_iterations = options_.inner_iterations;
+    solver.function_tolerance = options_.inner_function_tolerance;
     // Correspondences hold only near the current pose: start with modest steps.
     solver.initial_trust_region_radius = options_.initial_trust_radius;
     solver.num_threads = 1;

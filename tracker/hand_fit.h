@@ -24,6 +24,13 @@ struct HandFitOptions {
   /// Correspondence updates per frame, and Levenberg–Marquardt iterations per update.
   int outer_iterations = 4;
   int inner_iterations = 5;
+  /// An inner solve also stops once an iteration lowers its cost by less than this fraction
+  /// (Ceres' function tolerance; its own default is 1e-6). Its correspondences are found anew
+  /// at the next update anyway, and a fit that keeps creeping on stale ones only adds frame-to-
+  /// frame jitter: on the four recorded motions the contact error's median fell from 1.9–2.3 to
+  /// 1.4–1.75 mm at the same joint error, and the fit took a quarter less time; at 5e-2 the
+  /// joint error grew by 2–3 mm.
+  double inner_function_tolerance = 1e-2;
   /// Data points matched to the model (data → model) and visible model points matched to the
   /// data (model → data), at most; both are subsampled evenly.
   int max_data_points = 200;

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "render/offscreen_renderer.h"
 #include "tests/test_util.h"
@@ -164,6 +166,29 @@ double MeanJointError(const HandModel& model, const HandPose& pose,
 
 // A start far from the truth: about five frames of fast motion.
 constexpr double kRootRad = 0.08, kRootMm = 8, kAngleRad = 0.12;
+
+TEST(HandFitOptionsTest, BadValuesAreRefusedNamingTheField) {
+  EXPECT_NO_THROW(HandFitOptions().Check());
+  auto message = [](const HandFitOptions& options) {
+    try {
+      options.Check();
+    } catch (const std::invalid_argument& error) {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  HandFitOptions options;
+  options.outer_iterations = 0;
+  EXPECT_NE(message(options).find("outer_iterations"), std::string::npos);
+  options = HandFitOptions();
+  options.inner_function_tolerance = 0;
+  EXPECT_NE(message(options).find("inner_function_tolerance"), std::string::npos);
+  options.inner_function_tolerance = 1;
+  EXPECT_NE(message(options).find("inner_function_tolerance"), std::string::npos);
+  options = HandFitOptions();
+  options.data_point_weight = -1;
+  EXPECT_NE(message(options).find("data_point_weight"), std::string::npos);
+}
 
 TEST(HandFitterTest, RecoversAPerturbedPoseOfARenderedHand) {
   synth::SequenceOptions options;
