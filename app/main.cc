@@ -19,6 +19,7 @@
 #include "app/live_screen.h"
 #include "app/pipeline.h"
 #include "app/scanner_options.h"
+#include "core/allocator.h"
 #include "core/command_line.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
@@ -215,6 +216,7 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
 }  // namespace
 
 int main(int argc, char** argv) {
+  ihs::KeepFreedMemoryForReuse();
   CLI::App app{
       "inhandscan: scan a small object into a watertight 3D mesh while you turn it in "
       "one hand in front of a depth camera (Tzionas & Gall, ICCV 2015).",

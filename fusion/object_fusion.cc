@@ -149,7 +149,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
       }
     }
     // The model is needed only near the object's points: rays start a little in front of them.
-    std::vector<std::uint16_t> near(frame.depth_mm.size(), 0);
+    std::vector<std::uint16_t>& near = near_depth_;
+    near.assign(frame.depth_mm.size(), 0);
     for (int v = std::max(0, box[1]); v < box[3]; ++v) {
       for (int u = std::max(0, box[0]); u < box[2]; ++u) {
         const int pixel = v * frame.width + u;
@@ -160,7 +161,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
         static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
     auto align = [&](const Rigid3& predicted, const std::vector<IcpAnchor>& with) {
       const auto raycast_start = SteadyClock::now();
-      const RaycastImage model = volume_.Raycast(intrinsics_, predicted, roi, &near, window);
+      volume_.Raycast(intrinsics_, predicted, roi, &near, window, &model_image_);
+      const RaycastImage& model = model_image_;
       result.raycast_ms += MillisecondsSince(raycast_start);
       const auto icp_start = SteadyClock::now();
       IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, options_.icp, with);

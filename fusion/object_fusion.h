@@ -123,6 +123,9 @@ class ObjectFusion {
   const CameraIntrinsics intrinsics_;
   const FusionOptions options_;
   TsdfVolume volume_;
+  // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
+  RaycastImage model_image_;
+  std::vector<std::uint16_t> near_depth_;
   bool started_ = false;
   Rigid3 cam_from_object_;
   std::unordered_map<int, Anchor> anchors_;

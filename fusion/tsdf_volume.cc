@@ -190,19 +190,43 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
                                  const std::vector<std::uint16_t>* near_depth_mm,
                                  float window_mm) const {
   RaycastImage image;
-  image.width = intrinsics.width;
-  image.height = intrinsics.height;
-  const size_t pixels = static_cast<size_t>(image.width) * image.height;
-  image.depth_mm.assign(pixels, 0.0f);
-  image.normals.assign(pixels, Eigen::Vector3f::Zero());
-  image.colors.assign(pixels, {0, 0, 0});
+  Raycast(intrinsics, cam_from_volume, roi, near_depth_mm, window_mm, &image);
+  return image;
+}
+
+void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume,
+                         const std::array<int, 4>& roi,
+                         const std::vector<std::uint16_t>* near_depth_mm, float window_mm,
+                         RaycastImage* out) const {
+  RaycastImage& image = *out;
+  const size_t pixels = static_cast<size_t>(intrinsics.width) * intrinsics.height;
+  if (image.width != intrinsics.width || image.height != intrinsics.height ||
+      image.depth_mm.size() != pixels || image.normals.size() != pixels ||
+      image.colors.size() != pixels) {
+    image.width = intrinsics.width;
+    image.height = intrinsics.height;
+    image.depth_mm.assign(pixels, 0.0f);
+    image.normals.assign(pixels, Eigen::Vector3f::Zero());
+    image.colors.assign(pixels, {0, 0, 0});
+  } else {
+    const auto [x0, y0, x1, y1] = image.written;
+    for (int v = std::max(0, y0); v < std::min(image.height, y1); ++v) {
+      const size_t row = static_cast<size_t>(v) * image.width;
+      for (size_t p = row + std::max(0, x0); p < row + std::min(image.width, x1); ++p) {
+        image.depth_mm[p] = 0;
+        image.normals[p] = Eigen::Vector3f::Zero();
+        image.colors[p] = {0, 0, 0};
+      }
+    }
+  }
+  image.written = {0, 0, 0, 0};
   const Rigid3 volume_from_cam = cam_from_volume.Inverse();
   const Eigen::Matrix3f rotation = volume_from_cam.rotation().cast<float>();
   const Eigen::Vector3f origin = volume_from_cam.translation().cast<float>();
   const Eigen::Matrix3f to_cam = cam_from_volume.rotation().cast<float>();
   const float half = static_cast<float>(0.5 * options_.size_mm);
   const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
-  if (observed_hi_[0] < observed_lo_[0]) return image;  // Nothing to see yet.
+  if (observed_hi_[0] < observed_lo_[0]) return;  // Nothing to see yet.
   // Rays are followed only through the box of observed voxels.
   Eigen::Vector3f box_lo, box_hi;
   for (int a = 0; a < 3; ++a) {
@@ -215,6 +239,7 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
   const int u0 = whole ? 0 : std::max(0, roi[0]), v0 = whole ? 0 : std::max(0, roi[1]);
   const int u1 = whole ? image.width : std::min(image.width, roi[2]);
   const int v1 = whole ? image.height : std::min(image.height, roi[3]);
+  image.written = {u0, v0, u1, v1};
   for (int v = v0; v < v1; ++v) {
     for (int u = u0; u < u1; ++u) {
       const std::uint16_t near = near_depth_mm ? (*near_depth_mm)[v * image.width + u] : 0;
@@ -277,7 +302,6 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
       }
     }
   }
-  return image;
 }
 
 TriangleMesh TsdfVolume::ExtractMesh() const {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/allocator.h"
 #include "core/command_line.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
@@ -97,6 +98,7 @@ int Run(const Args& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  ihs::KeepFreedMemoryForReuse();
   CLI::App app{
       "The benchmark report: generator sequences scanned by ours and the baselines, measured "
       "against the ground truth (the paper's Table 1 and 2, joint error, Chamfer, speed, the γt "

@@ -21,6 +21,7 @@
 #include "app/scan_export.h"
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
+#include "core/allocator.h"
 #include "core/command_line.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
@@ -171,6 +172,7 @@ int Run(const Args& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  ihs::KeepFreedMemoryForReuse();
   CLI::App app{
       "Scan an object from a recording, stage after stage (no threads): mesh, object "
       "trajectory, hand joints, statistics; with --gt the paper's measures.",

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/allocator.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
 #include "core/errors.h"
@@ -179,6 +180,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
 }  // namespace
 
 int main(int argc, char** argv) {
+  ihs::KeepFreedMemoryForReuse();
   CLI::App app{"Track the hand through a recording: joints, contacts, statistics.",
                "inhandscan-track"};
   app.footer(ihs::ExitCodesHelp());

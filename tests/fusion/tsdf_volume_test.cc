@@ -120,6 +120,37 @@ TEST(TsdfVolumeTest, RaycastSeesTheSphereFromANewView) {
   EXPECT_LT(worst, 1.0);
 }
 
+// Casting into a reused image gives what a fresh image gets: what the earlier cast wrote
+// outside the new region is cleared.
+TEST(TsdfVolumeTest, RaycastIntoAReusedImageEqualsAFreshOne) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  TsdfVolume volume;
+  for (const Rigid3& view : test::ViewsAround(600)) {
+    volume.Integrate(RenderSphere(intrinsics, view), {}, intrinsics, view);
+  }
+  const Rigid3 first = Rigid3::Translation({0, 0, 600});
+  const Rigid3 second =
+      Rigid3::Translation({15, 5, 590}) * Rigid3::FromAxisAngle(Eigen::Vector3d(0, 1, 0), 0.3);
+  RaycastImage reused;
+  volume.Raycast(intrinsics, first, {0, 0, 0, 0}, nullptr, 0, &reused);
+  int first_hits = 0;
+  for (float d : reused.depth_mm) first_hits += d > 0;
+  ASSERT_GT(first_hits, 1000);
+  const std::array<int, 4> roi = {300, 200, 335, 300};  // About half the sphere.
+  volume.Raycast(intrinsics, second, roi, nullptr, 0, &reused);
+  const RaycastImage fresh = volume.Raycast(intrinsics, second, roi);
+  EXPECT_EQ(reused.written, roi);
+  int hits = 0;
+  for (size_t p = 0; p < fresh.depth_mm.size(); ++p) {
+    hits += fresh.depth_mm[p] > 0;
+    ASSERT_EQ(reused.depth_mm[p], fresh.depth_mm[p]) << "pixel " << p;
+    ASSERT_EQ(reused.normals[p], fresh.normals[p]) << "pixel " << p;
+    ASSERT_EQ(reused.colors[p], fresh.colors[p]) << "pixel " << p;
+  }
+  EXPECT_GT(hits, first_hits / 4);
+  EXPECT_LT(hits, 3 * first_hits / 4);
+}
+
 TEST(TsdfVolumeTest, MaskedPixelsAloneAreIntegratedAndBadInputIsRefused) {
   const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
   const Rigid3 view = Rigid3::Translation({0, 0, 600});
