@@ -108,10 +108,8 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
     // Against the ground truth: joints, and contact pairs moved by the object's true motion.
     if (!gt_joints.empty() && index < static_cast<std::int64_t>(gt_joints.size()) &&
         !result.joints_mm.empty()) {
-      double sum = 0;
-      for (size_t j = 0; j < result.joints_mm.size(); ++j)
-        sum += (result.joints_mm[j] - gt_joints[index].joints_mm[j]).norm();
-      joint_errors.push_back(sum / result.joints_mm.size());
+      joint_errors.push_back(
+          ihs::tracker::MeanJointError(result.joints_mm, gt_joints[index].joints_mm));
       entry["joint_error_mm"] = joint_errors.back();
     }
     if (index > 0 && index < static_cast<std::int64_t>(gt_trajectory.size())) {

@@ -88,4 +88,13 @@ std::vector<HandJointsRow> ReadHandJointsCsv(const std::filesystem::path& path) 
   return rows;
 }
 
+double MeanJointError(const std::vector<Eigen::Vector3d>& estimate_mm,
+                      const std::vector<Eigen::Vector3d>& truth_mm) {
+  IHS_CHECK_ARG(!truth_mm.empty() && estimate_mm.size() == truth_mm.size(),
+                "joint error of " << estimate_mm.size() << " joints against " << truth_mm.size());
+  double sum = 0;
+  for (size_t j = 0; j < truth_mm.size(); ++j) sum += (estimate_mm[j] - truth_mm[j]).norm();
+  return sum / static_cast<double>(truth_mm.size());
+}
+
 }  // namespace ihs::tracker

@@ -27,4 +27,9 @@ void WriteHandJointsCsv(const std::filesystem::path& path,
 /// Reads a hand_joints.csv. Throws ihs::InputError naming the file and line when malformed.
 std::vector<HandJointsRow> ReadHandJointsCsv(const std::filesystem::path& path);
 
+/// The joint error of an estimate against the truth: the mean distance between corresponding
+/// joints, mm. Throws std::invalid_argument unless both have the same, non-zero count.
+double MeanJointError(const std::vector<Eigen::Vector3d>& estimate_mm,
+                      const std::vector<Eigen::Vector3d>& truth_mm);
+
 }  // namespace ihs::tracker

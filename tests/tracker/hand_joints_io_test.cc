@@ -38,6 +38,19 @@ TEST(HandJointsIoTest, RoundTripsTheJointsOfAPosedHandToATenthOfAMicrometre) {
                std::invalid_argument);
 }
 
+TEST(HandJointsIoTest, MeanJointErrorIsTheMeanDistanceOfCorrespondingJoints) {
+  const std::vector<Eigen::Vector3d> truth = {{0, 0, 600}, {10, 0, 600}, {0, 10, 600}};
+  std::vector<Eigen::Vector3d> estimate = truth;
+  EXPECT_DOUBLE_EQ(MeanJointError(estimate, truth), 0.0);
+  estimate[0].x() += 3;                     // 3 mm
+  estimate[2].z() -= 4;                     // 4 mm
+  estimate[1] += Eigen::Vector3d(0, 3, 4);  // 5 mm
+  EXPECT_DOUBLE_EQ(MeanJointError(estimate, truth), 4.0);
+  estimate.pop_back();
+  EXPECT_THROW(MeanJointError(estimate, truth), std::invalid_argument);
+  EXPECT_THROW(MeanJointError({}, {}), std::invalid_argument);
+}
+
 TEST(HandJointsIoTest, MalformedFilesAreInputErrors) {
   test::TempDir dir;
   for (const char* bytes :

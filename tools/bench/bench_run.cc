@@ -165,11 +165,8 @@ CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
     mask_ms += packet.mask_ms;
     const std::int64_t index = read.frame->index;
     if (!packet.track.joints_mm.empty() && index < static_cast<std::int64_t>(gt_joints.size())) {
-      const auto& truth = gt_joints[index].joints_mm;
-      double sum = 0;
-      for (size_t j = 0; j < packet.track.joints_mm.size() && j < truth.size(); ++j)
-        sum += (packet.track.joints_mm[j] - truth[j]).norm();
-      joint_error_sum += sum / packet.track.joints_mm.size();
+      joint_error_sum +=
+          tracker::MeanJointError(packet.track.joints_mm, gt_joints[index].joints_mm);
       ++out.tracked_frames;
     }
     for (Runner& runner : runners) {
