@@ -52,10 +52,9 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       const Eigen::Vector3d p = correction * Eigen::Vector3d(point.cast<double>());
       if (p.z() <= 0) continue;
       const Eigen::Vector2d pixel = intrinsics.Project(p);
-      // The nearest pixel (truncation rounds for coordinates ≥ −0.5).
-      if (!(pixel.x() >= -0.5 && pixel.y() >= -0.5)) continue;
+      // The nearest pixel (inside the image, truncation rounds).
+      if (!intrinsics.Contains(pixel.x(), pixel.y())) continue;
       const int u = static_cast<int>(pixel.x() + 0.5), v = static_cast<int>(pixel.y() + 0.5);
-      if (u >= model.width || v >= model.height) continue;
       const size_t index = static_cast<size_t>(v) * model.width + u;
       const float depth = model.depth_mm[index];
       const Eigen::Vector3d normal = model.normals[index].cast<double>();

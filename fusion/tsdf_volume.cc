@@ -120,10 +120,9 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
                     static_cast<float>(intrinsics.cx);
     const float y = static_cast<float>(intrinsics.fy) * centre.y() / centre.z() +
                     static_cast<float>(intrinsics.cy);
-    // The nearest pixel (x, y ≥ −0.5 inside the image: truncation rounds there).
-    if (!(x >= -0.5f && y >= -0.5f)) return;
+    // The nearest pixel (inside the image, truncation rounds).
+    if (!intrinsics.Contains(x, y)) return;
     const int u = static_cast<int>(x + 0.5f), v = static_cast<int>(y + 0.5f);
-    if (u >= frame.width || v >= frame.height) return;
     const int pixel = v * frame.width + u;
     if (!observed(pixel)) return;
     const float along_ray = std::sqrt(centre.squaredNorm()) / centre.z();
