@@ -85,4 +85,24 @@ HandPose PoseFromBoneTransforms(const HandModel& model, const std::vector<Rigid3
   return pose;
 }
 
+bool IsRightHand(const HandModel& model) {
+  const auto dofs = JointDegreesOfFreedom(model);
+  const HandPose rest = HandPose::Rest(model);
+  HandPose flexed = rest;
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    if (dofs[k].axis == 1) flexed.angles_rad[k] = -0.6;
+  }
+  const auto joints = model.JointPositions(ForwardKinematics(model, rest));
+  const auto bent = model.JointPositions(ForwardKinematics(model, flexed));
+  auto end_of = [&](const char* bone) {
+    const int index = model.BoneIndex(bone);
+    IHS_CHECK_ARG(index >= 0, "IsRightHand: the model has no bone " << bone);
+    return static_cast<size_t>(index + 1);
+  };
+  const Eigen::Vector3d across = joints[end_of("RFing.3_Hand")] - joints[end_of("RFing.0_Hand")];
+  const Eigen::Vector3d along = joints[end_of("RFing.2_Hand")] - joints[0];
+  const size_t tip = end_of("RFing.2_2");
+  return across.cross(along).dot(bent[tip] - joints[tip]) > 0;
+}
+
 }  // namespace ihs::tracker

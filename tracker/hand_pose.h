@@ -41,4 +41,10 @@ std::vector<Rigid3> ForwardKinematics(const HandModel& model, const HandPose& po
 /// clamped to the limits. Used to initialise a fit from recorded motion.
 HandPose PoseFromBoneTransforms(const HandModel& model, const std::vector<Rigid3>& cam_from_bone);
 
+/// Whether `model` is a right hand: the direction across its knuckles from the little finger
+/// (RFing.0) to the index (RFing.3), crossed with the direction from the wrist to the middle
+/// knuckle, points to its palm (the side to which flexion takes the middle fingertip). A left
+/// hand is the mirror image; the paper's scanned hand is a right one.
+bool IsRightHand(const HandModel& model);
+
 }  // namespace ihs::tracker

@@ -15,10 +15,10 @@ namespace {
 constexpr double kTipBeyondEndMm = 1.7;
 
 // A bone frame at `start` whose x axis is `direction` and whose y (flexion) axis lies in the
-// palm plane, so that negative flexion bends toward the palm (+y).
+// palm plane, so that negative flexion bends toward the palm (-y).
 Rigid3 BoneFrame(const Eigen::Vector3d& start, const Eigen::Vector3d& direction) {
   const Eigen::Vector3d x = direction.normalized();
-  const Eigen::Vector3d y = Eigen::Vector3d::UnitY().cross(x).normalized();
+  const Eigen::Vector3d y = x.cross(Eigen::Vector3d::UnitY()).normalized();
   Eigen::Matrix3d rotation;
   rotation.col(0) = x;
   rotation.col(1) = y;
@@ -170,7 +170,7 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     Rigid3 frame = BoneFrame(start, direction);
     int parent = 0;
     const JointLimits joint_limits[4] = {
-        Limits({{{0, 0}, {-10, 1}, {0, 0}}}), Limits({{{0, 0}, {-95, 20}, {-15, 30}}}),
+        Limits({{{0, 0}, {-10, 1}, {0, 0}}}), Limits({{{0, 0}, {-95, 20}, {-30, 15}}}),
         Limits({{{0, 0}, {-100, 10}, {0, 0}}}), Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
     const char* names[4] = {"Hand", "0", "1", "2"};
     for (int k = 0; k < 4; ++k) {
@@ -181,9 +181,9 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   }
   // Thumb: from the side of the wrist, toward +x and forward, turned toward the palm.
   {
-    const Eigen::Vector3d start(18, 4, 5);
-    Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, 0.25, 0.6));
-    const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-30, 40}}}),
+    const Eigen::Vector3d start(18, -4, 5);
+    Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, -0.25, 0.6));
+    const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-40, 30}}}),
                                          Limits({{{0, 0}, {-60, 10}, {-15, 15}}}),
                                          Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
     const char* names[3] = {"Hand", "0", "1"};

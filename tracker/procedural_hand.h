@@ -43,9 +43,9 @@ struct ProceduralHandOptions {
   void Check() const;
 };
 
-/// Builds the procedural hand (HandModel::Scaled gives it another size). Rest pose: flat hand,
-/// fingers toward +z, thumb toward +x, palm facing +y (negative flexion bends toward the palm),
-/// wrist at the origin.
+/// Builds the procedural hand (HandModel::Scaled gives it another size): a right hand, like the
+/// paper's scanned one. Rest pose: flat hand, fingers toward +z, thumb toward +x, palm facing -y
+/// (negative flexion bends toward the palm), wrist at the origin.
 HandModel MakeProceduralHand(const ProceduralHandOptions& options = {});
 
 }  // namespace ihs::tracker

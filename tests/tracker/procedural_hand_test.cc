@@ -5,6 +5,8 @@
 #include <algorithm>
 
 #include "render/offscreen_renderer.h"
+#include "tests/test_util.h"
+#include "tracker/hand_data.h"
 #include "tracker/hand_pose.h"
 
 namespace ihs::tracker {
@@ -63,7 +65,7 @@ TEST(ProceduralHandTest, FlexionBendsFingersTowardThePalmAndKeepsTheSurface) {
   const auto rest_joints = hand.JointPositions(ForwardKinematics(hand, HandPose::Rest(hand)));
   const auto joints = hand.JointPositions(bones);
   for (int end : hand.EndEffectors()) {
-    EXPECT_GT(joints[end + 1].y() - rest_joints[end + 1].y(), 20) << hand.bones[end].name;
+    EXPECT_LT(joints[end + 1].y() - rest_joints[end + 1].y(), -20) << hand.bones[end].name;
   }
   const TriangleMesh posed = hand.Pose(bones);
   std::vector<double> stretch;
@@ -76,11 +78,24 @@ TEST(ProceduralHandTest, FlexionBendsFingersTowardThePalmAndKeepsTheSurface) {
   EXPECT_LT(stretch[stretch.size() / 2], 0.01);
 }
 
+TEST(ProceduralHandTest, IsARightHandLikeTheScannedOne) {
+  // The paper's data are of a right hand; a mirrored template cannot fit them (its fingers
+  // would have to bend backwards).
+  EXPECT_TRUE(IsRightHand(MakeProceduralHand()));
+  // Its mirror image as far as the kinematics go: fingers that flex toward the back.
+  HandModel mirrored = MakeProceduralHand();
+  for (JointLimits& limits : mirrored.limits) limits.axes[1] = -limits.axes[1];
+  EXPECT_FALSE(IsRightHand(mirrored));
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: the scanned hand not compared";
+  EXPECT_TRUE(IsRightHand(LoadHandModel(data)));
+}
+
 TEST(ProceduralHandTest, RendersAsAHandSizedBlobInFrontOfTheCamera) {
   const HandModel hand = MakeProceduralHand();
   render::OffscreenRenderer renderer(CameraIntrinsics{});
   render::RenderItem item{&hand.rest_mesh,
-                          Rigid3::FromAxisAngle({1, 0, 0}, -M_PI / 2, {0, 0, 600}),
+                          Rigid3::FromAxisAngle({1, 0, 0}, M_PI / 2, {0, 0, 600}),
                           {220, 170, 140},
                           false,
                           render::kHand};

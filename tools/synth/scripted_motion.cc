@@ -101,7 +101,7 @@ class GraspPlanner {
         dofs_(tracker::JointDegreesOfFreedom(hand)) {
     for (int finger : kGraspFingers) pads_.push_back(FindPad(hand, geometry_, finger));
     // Skin that must stay clear of the object: everything but the grasping fingertips, thinned
-    // to a few hundred vertices.
+    // to a couple of thousand vertices.
     std::vector<bool> pad_vertex(hand.rest_mesh.vertices.size(), false);
     for (const Pad& pad : pads_) {
       for (int v : geometry_.fingertip_vertices()[pad.tip]) pad_vertex[v] = true;
@@ -110,7 +110,7 @@ class GraspPlanner {
     for (size_t v = 0; v < pad_vertex.size(); ++v) {
       if (!pad_vertex[v]) others.push_back(static_cast<int>(v));
     }
-    const size_t stride = std::max<size_t>(1, others.size() / 800);
+    const size_t stride = std::max<size_t>(1, others.size() / 2000);
     for (size_t i = 0; i < others.size(); i += stride) clearance_vertices_.push_back(others[i]);
   }
 
@@ -350,10 +350,11 @@ Motion MakeScriptedMotion(const HandModel& hand, const ObjectShape& object,
                 "scripted.frames is too small for " << grasps << " grasps");
 
   // Where the object is: its axis leaning toward the camera, its centre ahead; turned about its
-  // axis so that the wrist starts on the camera's right, half a grasp before straight right.
+  // axis so that the wrist starts on the side of a person facing the camera that the hand
+  // belongs to (a right hand on the image's left), half a grasp before straight sideways.
   const double tilt = options.tilt_deg * M_PI / 180;
   const Eigen::Vector3d axis(0, -std::cos(tilt), -std::sin(tilt));
-  const Eigen::Vector3d side = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d side(tracker::IsRightHand(hand) ? -1.0 : 1.0, 0, 0);
   const Eigen::Vector3d wrist = first.object_from_root.translation();
   const double wrist_phi = std::atan2(wrist.y(), wrist.x());
   const double start_phi = std::atan2(0.3, 1.0) - step_rad / 2;  // From `side` toward +z.
