@@ -278,16 +278,6 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
           const Eigen::Vector3f point = origin + hit * ray;
           const size_t pixel = static_cast<size_t>(v) * image.width + u;
           image.depth_mm[pixel] = (hit * ray_cam.normalized()).z();
-          Eigen::Vector3f gradient;
-          bool ok = true;
-          for (int a = 0; a < 3 && ok; ++a) {
-            Eigen::Vector3f step = Eigen::Vector3f::Zero();
-            step[a] = voxel;
-            float plus = 0, minus = 0;
-            ok = SignedDistance(point + step, &plus) && SignedDistance(point - step, &minus);
-            gradient[a] = plus - minus;
-          }
-          if (ok && gradient.norm() > 1e-6f) image.normals[pixel] = to_cam * gradient.normalized();
           const Eigen::Vector3f grid = (point.array() + half) / voxel;
           const int i = std::clamp(static_cast<int>(grid.x()), 0, n_ - 1);
           const int j = std::clamp(static_cast<int>(grid.y()), 0, n_ - 1);
@@ -299,6 +289,54 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
         previous_t = t, previous = distance, has_previous = true;
         t += std::max(voxel, 0.8f * distance);
       }
+    }
+  }
+  // Normals from the hits' neighbours (as KinectFusion does): central differences of the
+  // surface points across the pixel, one-sided at the hits' edge; neighbours across a depth step
+  // of more than the truncation band lie on another surface. Where a pixel has no neighbour
+  // along a direction, the signed distance's central-difference gradient gives its normal.
+  auto surface_point = [&](int u, int v) -> Eigen::Vector3f {
+    return intrinsics.BackProject(u, v, image.depth_mm[static_cast<size_t>(v) * image.width + u])
+        .cast<float>();
+  };
+  for (int v = v0; v < v1; ++v) {
+    for (int u = u0; u < u1; ++u) {
+      const size_t pixel = static_cast<size_t>(v) * image.width + u;
+      const float depth = image.depth_mm[pixel];
+      if (depth == 0) continue;
+      auto usable = [&](int nu, int nv) {
+        if (nu < u0 || nu >= u1 || nv < v0 || nv >= v1) return false;
+        const float other = image.depth_mm[static_cast<size_t>(nv) * image.width + nu];
+        return other != 0 && std::abs(other - depth) <= band;
+      };
+      // The surface's tangent along one image axis: (du, dv) one pixel step.
+      auto tangent = [&](int du, int dv, Eigen::Vector3f* along) {
+        const bool ahead = usable(u + du, v + dv), behind = usable(u - du, v - dv);
+        if (!ahead && !behind) return false;
+        *along = (ahead ? surface_point(u + du, v + dv) : surface_point(u, v)) -
+                 (behind ? surface_point(u - du, v - dv) : surface_point(u, v));
+        return true;
+      };
+      Eigen::Vector3f across, down;
+      if (tangent(1, 0, &across) && tangent(0, 1, &down)) {
+        // Image x right, y down: down × across points toward the camera.
+        const Eigen::Vector3f normal = down.cross(across);
+        if (normal.squaredNorm() > 1e-12f) {
+          image.normals[pixel] = normal.normalized();
+          continue;
+        }
+      }
+      const Eigen::Vector3f point = volume_from_cam * surface_point(u, v);
+      Eigen::Vector3f gradient;
+      bool ok = true;
+      for (int a = 0; a < 3 && ok; ++a) {
+        Eigen::Vector3f step = Eigen::Vector3f::Zero();
+        step[a] = voxel;
+        float plus = 0, minus = 0;
+        ok = SignedDistance(point + step, &plus) && SignedDistance(point - step, &minus);
+        gradient[a] = plus - minus;
+      }
+      if (ok && gradient.norm() > 1e-6f) image.normals[pixel] = to_cam * gradient.normalized();
     }
   }
 }
