@@ -7,7 +7,6 @@
 #include "fusion/sift_matcher.h"
 #include "tracker/hand_data.h"
 #include "tracker/hand_kinematics.h"
-#include "tracker/procedural_hand.h"
 
 namespace ihs::app {
 namespace {
@@ -30,9 +29,7 @@ const ScannerOptions& Checked(const ScannerOptions& options) {
 }  // namespace
 
 tracker::HandModel LoadHandTemplate(const ScanOptions& options) {
-  tracker::HandModel model = options.hand_template == "procedural"
-                                 ? tracker::MakeProceduralHand()
-                                 : tracker::LoadHandModel(options.hand_template);
+  tracker::HandModel model = tracker::LoadHandTemplate(options.hand_template, !options.left_hand);
   if (options.hand_scale > 0) model = model.Scaled(options.hand_scale);
   return model;
 }

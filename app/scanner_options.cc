@@ -41,6 +41,8 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "hand template: procedural, or the folder of a scanned hand model");
   r.Add("scan.hand_scale", &scan.hand_scale,
         "template scale (0: estimated over the first frames for the procedural template)");
+  r.Add("scan.left_hand", &scan.left_hand,
+        "the scanning hand is a left one (the procedural template is mirrored)");
   r.Add("scan.hand_dilation_px", &scan.hand_dilation_px,
         "pixels around the posed hand model never counted as the object");
   r.Add("scan.hand_depth_margin_mm", &scan.hand_depth_margin_mm,

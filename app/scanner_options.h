@@ -23,6 +23,9 @@ struct ScanOptions {
   /// Scale of the template (0: the procedural template's is estimated over the first frames, a
   /// scanned template is used at 1).
   double hand_scale = 0.0;
+  /// The scanning hand is a left one: the procedural template is built mirrored, and a scanned
+  /// template must be a left hand (the paper's, and the default, is a right hand).
+  bool left_hand = false;
   /// Pixels around the posed hand model that are never the object's (the paper: "dilated a few
   /// pixels").
   int hand_dilation_px = 4;

@@ -38,7 +38,7 @@ namespace fs = std::filesystem;
 struct Args {
   std::string input, out, gt, object, template_name = "procedural";
   bool init_from_gt = false, no_icp = false, contacts_only = false, no_color = false;
-  bool no_anchors = false, features_3d = false;
+  bool no_anchors = false, features_3d = false, left_hand = false;
   double hand_scale = 0, gamma_t = 15.0;
   int hand_dilation_px = 4;
   std::int64_t max_frames = 0;
@@ -50,6 +50,7 @@ int Run(const Args& args) {
   ihs::app::ScannerOptions options;
   options.scan.hand_template = args.template_name;
   options.scan.hand_scale = args.hand_scale;
+  options.scan.left_hand = args.left_hand;
   options.scan.hand_dilation_px = args.hand_dilation_px;
   options.scan.features_2d = !args.contacts_only;
   options.scan.features_3d = args.features_3d && !args.contacts_only;
@@ -195,6 +196,9 @@ int main(int argc, char** argv) {
                  "scale of the template (default: the procedural one estimated over the first "
                  "frames, a scanned one 1)")
       ->check(CLI::Range(0.5, 2.0));
+  app.add_flag("--left-hand", args.left_hand,
+               "the hand is a left one (the procedural template is mirrored; a scanned one must "
+               "be a left hand)");
   app.add_option("--gamma-t", args.gamma_t,
                  "weight of the fingertip contacts (paper: 15; 0: "
                  "visual features only)")

@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.5, 2.0));
   app.add_option("--hand", options.hand, "procedural, or the real hand data folder")
       ->capture_default_str();
+  app.add_flag("--left-hand", options.left_hand,
+               "a left hand (scripted motion; the procedural hand mirrored)");
   app.add_option("--frames", frames, "frame range A:B of the motion (default: all)");
   app.add_option("--seed", options.seed, "seed of every random choice")->capture_default_str();
   app.add_flag("--no-noise", no_noise, "an ideal sensor (depth rounded to mm, nothing else)");

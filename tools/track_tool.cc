@@ -24,7 +24,6 @@
 #include "tracker/hand_data.h"
 #include "tracker/hand_joints_io.h"
 #include "tracker/hand_tracker.h"
-#include "tracker/procedural_hand.h"
 
 namespace {
 
@@ -40,9 +39,8 @@ double Quantile(std::vector<double> values, double q) {
 
 // hand_scale: the template's scale, or 0 to estimate it over the first frames.
 int Run(const std::string& input, const fs::path& out, const std::string& gt_dir, bool init_from_gt,
-        const std::string& template_name, double hand_scale) {
-  HandModel model = template_name == "procedural" ? ihs::tracker::MakeProceduralHand()
-                                                  : ihs::tracker::LoadHandModel(template_name);
+        const std::string& template_name, double hand_scale, bool left_hand) {
+  HandModel model = ihs::tracker::LoadHandTemplate(template_name, !left_hand);
   // The procedural template's size is estimated unless given; a scanned hand has its owner's.
   ihs::tracker::TrackerOptions options;
   if (hand_scale > 0) model = model.Scaled(hand_scale);
@@ -184,7 +182,7 @@ int main(int argc, char** argv) {
   app.footer(ihs::ExitCodesHelp());
   app.set_version_flag("--version", std::string("inhandscan-track ") + IHS_VERSION);
   std::string input, out, gt, template_name = "procedural", log_level = "info";
-  bool init_from_gt = false, quiet = false;
+  bool init_from_gt = false, left_hand = false, quiet = false;
   double hand_scale = 0.0;
   app.add_option("input", input, ".oni file or TUM folder")->required();
   app.add_option("--out", out, "output folder")->required();
@@ -196,11 +194,14 @@ int main(int argc, char** argv) {
                  "scale of the template (default: the procedural one estimated over the first "
                  "frames, a scanned one 1)")
       ->check(CLI::Range(0.5, 2.0));
+  app.add_flag("--left-hand", left_hand,
+               "the hand is a left one (the procedural template is mirrored; a scanned one must "
+               "be a left hand)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-track", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
-    return Run(input, out, gt, init_from_gt, template_name, hand_scale);
+    return Run(input, out, gt, init_from_gt, template_name, hand_scale, left_hand);
   });
 }

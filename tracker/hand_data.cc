@@ -7,6 +7,8 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "tracker/hand_pose.h"
+#include "tracker/procedural_hand.h"
 
 namespace ihs::tracker {
 namespace fs = std::filesystem;
@@ -240,6 +242,20 @@ HandModel LoadHandModel(const fs::path& data_dir) {
   }
   std::sort(sessions.begin(), sessions.end());
   return LoadRecordedHand(data_dir, sessions.front()).model;
+}
+
+HandModel LoadHandTemplate(const std::string& name, bool right_hand) {
+  if (name == "procedural") {
+    ProceduralHandOptions options;
+    options.right_hand = right_hand;
+    return MakeProceduralHand(options);
+  }
+  HandModel model = LoadHandModel(name);
+  if (IsRightHand(model) != right_hand) {
+    throw InputError("the hand template in " + name + " is a " + (right_hand ? "left" : "right") +
+                     " hand, the scan asks for a " + (right_hand ? "right" : "left") + " one");
+  }
+  return model;
 }
 
 }  // namespace ihs::tracker

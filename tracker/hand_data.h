@@ -29,6 +29,11 @@ RecordedHand LoadRecordedHand(const std::filesystem::path& data_dir,
 /// ihs::InputError when the folder holds no session.
 HandModel LoadHandModel(const std::filesystem::path& data_dir);
 
+/// The tracker's template: "procedural" (the project's own hand, MakeProceduralHand, built as a
+/// right or a left hand) or a data folder holding a scanned hand (LoadHandModel). Throws
+/// ihs::InputError when a scanned hand is not of the side asked for.
+HandModel LoadHandTemplate(const std::string& name, bool right_hand = true);
+
 /// Reads an OFF triangle mesh (3-vertex faces; larger polygons are fanned).
 TriangleMesh ReadOffMesh(const std::filesystem::path& path);
 

@@ -15,10 +15,11 @@ namespace {
 constexpr double kTipBeyondEndMm = 1.7;
 
 // A bone frame at `start` whose x axis is `direction` and whose y (flexion) axis lies in the
-// palm plane, so that negative flexion bends toward the palm (-y).
-Rigid3 BoneFrame(const Eigen::Vector3d& start, const Eigen::Vector3d& direction) {
+// palm plane, so that negative flexion bends toward the palm: -y for a right hand (`palm` = -1),
+// +y for a left one (`palm` = +1).
+Rigid3 BoneFrame(const Eigen::Vector3d& start, const Eigen::Vector3d& direction, double palm) {
   const Eigen::Vector3d x = direction.normalized();
-  const Eigen::Vector3d y = x.cross(Eigen::Vector3d::UnitY()).normalized();
+  const Eigen::Vector3d y = (-palm * x.cross(Eigen::Vector3d::UnitY())).normalized();
   Eigen::Matrix3d rotation;
   rotation.col(0) = x;
   rotation.col(1) = y;
@@ -26,7 +27,12 @@ Rigid3 BoneFrame(const Eigen::Vector3d& start, const Eigen::Vector3d& direction)
   return Rigid3(rotation, start);
 }
 
-JointLimits Limits(std::array<std::pair<double, double>, 3> ranges_deg) {
+// The limits of a right hand's joint, or of the mirrored joint of a left hand: mirroring keeps
+// the flexion axis (BoneFrame) but turns twist and spread the other way round their axes.
+JointLimits Limits(std::array<std::pair<double, double>, 3> ranges_deg, bool right_hand) {
+  if (!right_hand) {
+    for (int k : {0, 2}) ranges_deg[k] = {-ranges_deg[k].second, -ranges_deg[k].first};
+  }
   JointLimits limits;
   limits.limits_deg = ranges_deg;
   for (int k = 0; k < 3; ++k) limits.active[k] = ranges_deg[k].first != ranges_deg[k].second;
@@ -156,8 +162,11 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   root.translation = true;
   root.active = {true, true, true};
   root.limits_deg = {{{-180, 180}, {-180, 180}, {-180, 180}}};
+  const bool right = options.right_hand;
+  const double palm = right ? -1.0 : 1.0;  // The palm's side along y.
   const double wrist = options.wrist_length_mm;
-  add_bone("Lower Arm R", -1, wrist, BoneFrame({0, 0, -wrist}, Eigen::Vector3d::UnitZ()), root);
+  add_bone("Lower Arm R", -1, wrist, BoneFrame({0, 0, -wrist}, Eigen::Vector3d::UnitZ(), palm),
+           root);
 
   // Fingers 0..3 (pinky to index): metacarpals fan out from the wrist to the knuckles.
   const double base_x[4] = {-15, -5, 5, 15}, knuckle_x[4] = {-30, -10, 10, 30};
@@ -167,11 +176,12 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     const Eigen::Vector3d start(base_x[f], 0, 0);
     const Eigen::Vector3d knuckle(knuckle_x[f], 0, lengths[0]);
     const Eigen::Vector3d direction = (knuckle - start).normalized();
-    Rigid3 frame = BoneFrame(start, direction);
+    Rigid3 frame = BoneFrame(start, direction, palm);
     int parent = 0;
-    const JointLimits joint_limits[4] = {
-        Limits({{{0, 0}, {-10, 1}, {0, 0}}}), Limits({{{0, 0}, {-95, 20}, {-30, 15}}}),
-        Limits({{{0, 0}, {-100, 10}, {0, 0}}}), Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
+    const JointLimits joint_limits[4] = {Limits({{{0, 0}, {-10, 1}, {0, 0}}}, right),
+                                         Limits({{{0, 0}, {-95, 20}, {-30, 15}}}, right),
+                                         Limits({{{0, 0}, {-100, 10}, {0, 0}}}, right),
+                                         Limits({{{0, 0}, {-90, 10}, {0, 0}}}, right)};
     const char* names[4] = {"Hand", "0", "1", "2"};
     for (int k = 0; k < 4; ++k) {
       const double length = (k == 0 ? (knuckle - start).norm() : lengths[k]);
@@ -181,11 +191,11 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   }
   // Thumb: from the side of the wrist, toward +x and forward, turned toward the palm.
   {
-    const Eigen::Vector3d start(18, -4, 5);
-    Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, -0.25, 0.6));
-    const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-40, 30}}}),
-                                         Limits({{{0, 0}, {-60, 10}, {-15, 15}}}),
-                                         Limits({{{0, 0}, {-90, 10}, {0, 0}}})};
+    const Eigen::Vector3d start(18, 4 * palm, 5);
+    Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, 0.25 * palm, 0.6), palm);
+    const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-40, 30}}}, right),
+                                         Limits({{{0, 0}, {-60, 10}, {-15, 15}}}, right),
+                                         Limits({{{0, 0}, {-90, 10}, {0, 0}}}, right)};
     const char* names[3] = {"Hand", "0", "1"};
     int parent = 0;
     for (int k = 0; k < 3; ++k) {
@@ -218,7 +228,8 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     if (to_wrist > 0) weights.bones.emplace_back(0, static_cast<float>(to_wrist));
     return weights;
   };
-  AppendCapsule(model, BoneFrame({0, 0, 8}, Eigen::Vector3d::UnitZ()), palm_length, palm_radius, 12,
+  AppendCapsule(model, BoneFrame({0, 0, 8}, Eigen::Vector3d::UnitZ(), palm), palm_length,
+                palm_radius, 12,
                 {options.palm_thickness_mm / options.palm_base_width_mm, 3.0,
                  options.palm_width_mm / options.palm_base_width_mm},
                 segments * 2, palm_weights);

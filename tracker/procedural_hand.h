@@ -38,14 +38,17 @@ struct ProceduralHandOptions {
   double wrist_thickness_mm = 38.0;
   /// Segments around each capsule.
   int segments = 16;
+  /// A right hand (the paper's scanned hand is one); false builds its mirror image, a left hand.
+  bool right_hand = true;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
 };
 
-/// Builds the procedural hand (HandModel::Scaled gives it another size): a right hand, like the
-/// paper's scanned one. Rest pose: flat hand, fingers toward +z, thumb toward +x, palm facing -y
-/// (negative flexion bends toward the palm), wrist at the origin.
+/// Builds the procedural hand (HandModel::Scaled gives it another size): by default a right
+/// hand, like the paper's scanned one. Rest pose: flat hand, fingers toward +z, thumb toward +x,
+/// palm facing -y for a right hand and +y for a left one (negative flexion bends toward the
+/// palm), wrist at the origin.
 HandModel MakeProceduralHand(const ProceduralHandOptions& options = {});
 
 }  // namespace ihs::tracker

@@ -8,6 +8,7 @@
 
 #include "core/errors.h"
 #include "tests/test_util.h"
+#include "tracker/hand_pose.h"
 
 namespace ihs::tracker {
 namespace {
@@ -34,6 +35,21 @@ TEST(HandDataTest, LoadsTheRealModelWithItsDocumentedShape) {
   EXPECT_FALSE(middle_joint.active[2]);
   EXPECT_EQ(middle_joint.limits_deg[1], (std::pair<double, double>{-95, 10}));
   EXPECT_TRUE(model.limits[0].translation);
+}
+
+TEST(HandDataTest, ATemplateIsOfTheHandSideAskedFor) {
+  EXPECT_TRUE(IsRightHand(LoadHandTemplate("procedural")));
+  EXPECT_FALSE(IsRightHand(LoadHandTemplate("procedural", false)));
+  EXPECT_THROW(LoadHandTemplate("/nonexistent-hand-folder"), InputError);
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: the scanned hand not checked";
+  EXPECT_TRUE(IsRightHand(LoadHandTemplate(data.string())));
+  try {
+    LoadHandTemplate(data.string(), false);
+    ADD_FAILURE() << "a right hand's scan was taken for a left hand";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("is a right hand"), std::string::npos) << error.what();
+  }
 }
 
 TEST(HandDataTest, RestRowReproducesTheRestMeshExactly) {

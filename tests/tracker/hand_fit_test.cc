@@ -275,9 +275,15 @@ TEST(HandFitterTest, TracksTheScriptedMotionCoarsely) {
   options.object = "sphere";
   options.scripted.frames = 240;
   options.last_frame = 79;
-  // Measured 10.5 mm mean, 19.2 mm worst over these 80 frames: the hand holds the object from
-  // behind, mostly hidden, and its wrist drifts.
+  // The left hand from the image's right, the scene this test was first written for: measured
+  // 6.1 mm mean, 15.5 mm worst over these 80 frames (10.5 mm before the grasp kept 2000 skin
+  // vertices clear of the object instead of 800).
+  options.left_hand = true;
   EXPECT_LT(TrackFromTheFirstPose(options), 15.0);
+  // The right hand (the default) from the image's left: measured 15.3 mm mean, 35.7 mm worst —
+  // its fingers hide more of themselves behind the ball in these frames, and the wrist drifts.
+  options.left_hand = false;
+  EXPECT_LT(TrackFromTheFirstPose(options), 20.0);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
+#include "tracker/hand_data.h"
 #include "tracker/procedural_hand.h"
 
 namespace ihs::tracker {
@@ -151,6 +152,32 @@ TEST(HandTrackerTest, InitialisesFromTheOpenHandAndRecoversAfterAJump) {
 
 namespace ihs::tracker {
 namespace {
+
+TEST(HandTrackerTest, ALeftHandIsTrackedWithTheMirroredTemplate) {
+  synth::SequenceOptions options;  // The procedural hand, mirrored, turning the sphere.
+  options.left_hand = true;
+  options.scripted.frames = 40;
+  options.scripted.turns = 0.25;
+  synth::SequenceRenderer renderer(options);
+  auto mean_joint_error = [&](const HandModel& model) {
+    TrackerOptions tracker_options;
+    tracker_options.scale_frames = 0;
+    HandTracker tracker(model, renderer.options().intrinsics, tracker_options);
+    tracker.Initialise(FitPoseToJoints(model, renderer.Render(0).joints_mm));
+    double error = 0;
+    for (int i = 0; i < renderer.frame_count(); ++i) {
+      const synth::RenderedFrame rendered = renderer.Render(i);
+      error += MeanJointError(tracker.Track(rendered.frame).joints_mm, rendered.joints_mm);
+    }
+    return error / renderer.frame_count();
+  };
+  const double left = mean_joint_error(LoadHandTemplate("procedural", false));
+  const double right = mean_joint_error(MakeProceduralHand());
+  std::printf("left hand: %.2f mm with the left template, %.2f mm with the right one\n", left,
+              right);
+  EXPECT_LT(left, 5.0);
+  EXPECT_GT(right, 2 * left);
+}
 
 TEST(HandTrackerTest, TheProceduralTemplateFollowsTheRealHand) {
   if (test::HandDataDir().empty()) GTEST_SKIP() << "../shared/data is absent";

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "render/offscreen_renderer.h"
 #include "tests/test_util.h"
@@ -89,6 +91,39 @@ TEST(ProceduralHandTest, IsARightHandLikeTheScannedOne) {
   const auto data = test::HandDataDir();
   if (data.empty()) GTEST_SKIP() << "../shared/data is absent: the scanned hand not compared";
   EXPECT_TRUE(IsRightHand(LoadHandModel(data)));
+}
+
+TEST(ProceduralHandTest, ALeftHandIsTheRightOnesMirrorImage) {
+  ProceduralHandOptions options;
+  options.right_hand = false;
+  const HandModel left = MakeProceduralHand(options);
+  const HandModel right = MakeProceduralHand();
+  EXPECT_FALSE(IsRightHand(left));
+  EXPECT_TRUE(left.rest_mesh.IsWatertight());
+  EXPECT_NEAR(left.rest_mesh.Volume(), right.rest_mesh.Volume(), 1e-3 * right.rest_mesh.Volume());
+  const Eigen::Vector3d mirror(1, -1, 1);
+  // Every skin vertex of the left hand mirrors onto one of the right hand's.
+  ASSERT_EQ(left.rest_mesh.vertices.size(), right.rest_mesh.vertices.size());
+  double farthest = 0;
+  for (const Eigen::Vector3f& vertex : left.rest_mesh.vertices) {
+    const Eigen::Vector3f mirrored = vertex.cwiseProduct(mirror.cast<float>());
+    float nearest = std::numeric_limits<float>::infinity();
+    for (const Eigen::Vector3f& other : right.rest_mesh.vertices)
+      nearest = std::min(nearest, (other - mirrored).squaredNorm());
+    farthest = std::max(farthest, static_cast<double>(std::sqrt(nearest)));
+  }
+  EXPECT_LT(farthest, 1e-3);
+  // The same flexion, with twist and spread the other way round, poses the mirror image.
+  const auto dofs = JointDegreesOfFreedom(right);
+  HandPose right_pose = HandPose::Rest(right), left_pose = HandPose::Rest(left);
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    right_pose.angles_rad[k] = dofs[k].axis == 1 ? -0.5 : 0.15;
+    left_pose.angles_rad[k] = dofs[k].axis == 1 ? -0.5 : -0.15;
+  }
+  const auto right_joints = right.JointPositions(ForwardKinematics(right, right_pose));
+  const auto left_joints = left.JointPositions(ForwardKinematics(left, left_pose));
+  for (size_t j = 0; j < right_joints.size(); ++j)
+    EXPECT_LT((left_joints[j] - right_joints[j].cwiseProduct(mirror)).norm(), 1e-9) << j;
 }
 
 TEST(ProceduralHandTest, RendersAsAHandSizedBlobInFrontOfTheCamera) {

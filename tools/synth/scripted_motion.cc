@@ -354,10 +354,15 @@ Motion MakeScriptedMotion(const HandModel& hand, const ObjectShape& object,
   // belongs to (a right hand on the image's left), half a grasp before straight sideways.
   const double tilt = options.tilt_deg * M_PI / 180;
   const Eigen::Vector3d axis(0, -std::cos(tilt), -std::sin(tilt));
-  const Eigen::Vector3d side(tracker::IsRightHand(hand) ? -1.0 : 1.0, 0, 0);
+  const bool right_hand = tracker::IsRightHand(hand);
+  const Eigen::Vector3d side(right_hand ? -1.0 : 1.0, 0, 0);
   const Eigen::Vector3d wrist = first.object_from_root.translation();
   const double wrist_phi = std::atan2(wrist.y(), wrist.x());
-  const double start_phi = std::atan2(0.3, 1.0) - step_rad / 2;  // From `side` toward +z.
+  // About the axis from `side`: toward +z (behind the object) on the right, toward -z on the
+  // left. The right hand's wrist sweeps the left hand's positions mirrored (from 62° behind to
+  // 28° in front of straight sideways for 90° grasps), so both see the object past the thumb.
+  const double start_phi =
+      right_hand ? -(std::atan2(0.3, 1.0) + step_rad / 2) : std::atan2(0.3, 1.0) - step_rad / 2;
   const double psi = start_phi - wrist_phi;
   const Eigen::Vector3d b = Eigen::AngleAxisd(psi, axis) * side;
   Eigen::Matrix3d rotation;

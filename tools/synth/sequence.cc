@@ -19,7 +19,6 @@
 #include "tools/synth/hand_object.h"
 #include "tracker/hand_data.h"
 #include "tracker/hand_joints_io.h"
-#include "tracker/procedural_hand.h"
 
 namespace ihs::synth {
 namespace {
@@ -84,6 +83,8 @@ void SequenceOptions::Check() const {
   IHS_CHECK_ARG(hand_scale >= 0.5 && hand_scale <= 2.0, "hand scale must be in [0.5, 2]");
   IHS_CHECK_ARG(hand_scale == 1.0 || motion == "scripted",
                 "a hand scale needs the scripted motion (a recorded motion has its own hand)");
+  IHS_CHECK_ARG(!left_hand || motion == "scripted",
+                "a left hand needs the scripted motion (the recorded hand is a right one)");
   intrinsics.Check();
   sensor.Check();
   scripted.Check();
@@ -105,11 +106,7 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     motion_ = MakeRecordedMotion(recording, object_, recorded_options, &recorded_report_);
     hand_ = std::move(recording.model);
   } else {
-    if (options_.hand == "procedural") {
-      hand_ = tracker::MakeProceduralHand();
-    } else {
-      hand_ = tracker::LoadHandModel(options_.hand);
-    }
+    hand_ = tracker::LoadHandTemplate(options_.hand, !options_.left_hand);
     if (options_.hand_scale != 1.0) hand_ = hand_.Scaled(options_.hand_scale);
     motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }

@@ -48,6 +48,9 @@ struct SequenceOptions {
   /// The hand's size relative to the template (scripted motion only: a recorded motion comes
   /// with its own hand).
   double hand_scale = 1.0;
+  /// A left hand turns the object (scripted motion only: the recorded hand is a right one): the
+  /// procedural hand is built mirrored, a scanned hand must be a left one.
+  bool left_hand = false;
   /// Frames [first_frame, last_frame] of the motion (last_frame −1: to the end).
   int first_frame = 0;
   int last_frame = -1;
