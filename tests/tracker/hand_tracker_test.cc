@@ -175,8 +175,9 @@ TEST(HandTrackerTest, ALeftHandIsTrackedWithTheMirroredTemplate) {
   const double right = mean_joint_error(MakeProceduralHand());
   std::printf("left hand: %.2f mm with the left template, %.2f mm with the right one\n", left,
               right);
-  EXPECT_LT(left, 5.0);
-  EXPECT_GT(right, 2 * left);
+  // Measured 4.4 mm with the left template, 34.6 mm with the right one.
+  EXPECT_LT(left, 6.0);
+  EXPECT_GT(right, 3 * left);
 }
 
 TEST(HandTrackerTest, TheProceduralTemplateFollowsTheRealHand) {
@@ -198,11 +199,11 @@ TEST(HandTrackerTest, TheProceduralTemplateFollowsTheRealHand) {
   }
   std::printf("procedural template: start %.2f mm, mean joint error %.2f mm over %d frames\n",
               start_error, error / renderer.frame_count(), renderer.frame_count());
-  // Measured: start 2.47 mm, 8.0 mm mean over frames 0–60 (9.8 mm over 0–299 with
-  // inhandscan-track; the target is 10 mm): the template's shape differs from the real
-  // hand's, and the fit slides toward the wrist by about 5 mm.
+  // Measured: start 2.51 mm, 6.8 mm mean over frames 0–60 (7.8 mm over 0–299 and 8.0 mm over
+  // the whole session with inhandscan-track; the target is 10 mm): the template's
+  // proportions differ from the real hand's (docs/tracker.md, "Known limits").
   EXPECT_LT(start_error, 5.0);
-  EXPECT_LT(error / renderer.frame_count(), 11.0);
+  EXPECT_LT(error / renderer.frame_count(), 10.0);
 }
 
 }  // namespace
