@@ -359,8 +359,8 @@ Motion MakeScriptedMotion(const HandModel& hand, const ObjectShape& object,
   const Eigen::Vector3d wrist = first.object_from_root.translation();
   const double wrist_phi = std::atan2(wrist.y(), wrist.x());
   // About the axis from `side`: toward +z (behind the object) on the right, toward -z on the
-  // left. The right hand's wrist sweeps the left hand's positions mirrored (from 62° behind to
-  // 28° in front of straight sideways for 90° grasps), so both see the object past the thumb.
+  // left. A right hand's wrist passes the mirror images of a left hand's positions (for 90°
+  // grasps from 62° behind to 28° in front of straight sideways), in the other order.
   const double start_phi =
       right_hand ? -(std::atan2(0.3, 1.0) + step_rad / 2) : std::atan2(0.3, 1.0) - step_rad / 2;
   const double psi = start_phi - wrist_phi;
