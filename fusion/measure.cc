@@ -56,10 +56,12 @@ double Mean(const std::vector<double>& values) {
 
 // The measures of `mesh` taken along `axis` through `centre`; `residual` gets how far the side
 // vertices are from their sections' circles (weighted RMS over the mean radius): small when the
-// axis is a symmetry axis.
-static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Vector3d& centre,
-                                       const Eigen::Vector3d& axis, double slice_mm,
-                                       double* residual) {
+// axis is a symmetry axis. `circle_centres`, when given, gets the centre of each section that
+// counts, with its weight.
+static RevolutionMeasures MeasureAlong(
+    const TriangleMesh& mesh, const Eigen::Vector3d& centre, const Eigen::Vector3d& axis,
+    double slice_mm, double* residual,
+    std::vector<std::pair<Eigen::Vector3d, double>>* circle_centres = nullptr) {
   RevolutionMeasures result;
   result.axis = axis;
   result.centre = centre;
@@ -141,6 +143,12 @@ static RevolutionMeasures MeasureAlong(const TriangleMesh& mesh, const Eigen::Ve
   for (int b = 0; b < bins; ++b) {
     if (weight[b] <= 0 || weight[b] < min_weight || radius[b] <= 0) continue;
     result.profile.push_back({(b + 0.5) * slice_mm, 2 * radius[b]});
+    if (circle_centres) {
+      circle_centres->push_back({centre + (low + (b + 0.5) * slice_mm) * result.axis +
+                                     circle_centre[b].x() * across_u +
+                                     circle_centre[b].y() * across_v,
+                                 weight[b]});
+    }
   }
   if (result.profile.empty()) return result;
 
@@ -193,6 +201,37 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
     RevolutionMeasures candidate =
         MeasureAlong(mesh, centre, solver.eigenvectors().col(k).normalized(), slice_mm, &residual);
     if (residual < best) best = residual, result = std::move(candidate);
+  }
+  // The principal axis of a surface seen in part (or of a squat body) can be tilted by a degree
+  // or more from the symmetry axis, which lengthens the height by about the width times the
+  // tilt. The sections' circle centres lie on the symmetry axis whatever the tilt (a tilted cut
+  // through a body of revolution is centred on its axis), so the line through them is a better
+  // axis: iterate to a fixed point, as long as the sections stay as round.
+  for (int iteration = 0; iteration < 10 && std::isfinite(best); ++iteration) {
+    std::vector<std::pair<Eigen::Vector3d, double>> centres;
+    double residual = INFINITY;
+    MeasureAlong(mesh, result.centre, result.axis, slice_mm, &residual, &centres);
+    if (centres.size() < 5) break;
+    double total = 0;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& [point, weight] : centres) mean += weight * point, total += weight;
+    mean /= total;
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (const auto& [point, weight] : centres)
+      scatter += weight * (point - mean) * (point - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> line(scatter / total);
+    // The centres must spread along a line (a sphere's or a disc's do not).
+    const Eigen::Vector3d spread = line.eigenvalues();
+    if (spread[2] < 25.0 || spread[1] > 0.05 * spread[2]) break;
+    Eigen::Vector3d axis = line.eigenvectors().col(2);
+    if (axis.dot(result.axis) < 0) axis = -axis;
+    // The refinement corrects a small tilt; a large one means the centres are not on a line.
+    if (axis.dot(result.axis) < std::cos(10.0 * M_PI / 180.0)) break;
+    RevolutionMeasures candidate = MeasureAlong(mesh, centre, axis, slice_mm, &residual);
+    if (residual > 1.05 * best) break;
+    const double change = std::acos(std::min(1.0, axis.dot(result.axis)));
+    best = std::min(best, residual), result = std::move(candidate);
+    if (change < 1e-4) break;
   }
   return result;
 }
