@@ -21,6 +21,7 @@
 #include "app/scan_export.h"
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
+#include "app/scanner_options.h"
 #include "core/allocator.h"
 #include "core/command_line.h"
 #include "core/errors.h"
@@ -42,6 +43,7 @@ struct Args {
   double hand_scale = 0, gamma_t = 15.0;
   int hand_dilation_px = 4;
   std::int64_t max_frames = 0;
+  std::vector<std::string> assignments;  // --set NAME=VALUE, applied after the flags above.
 };
 
 int Run(const Args& args) {
@@ -60,6 +62,9 @@ int Run(const Args& args) {
   options.fusion.anchor_contacts = !args.no_anchors;
   options.fusion.tsdf.color = !args.no_color;
   options.meshing.color = !args.no_color;
+  ihs::app::OptionRegistry registry = ihs::app::RegisterScannerOptions(&options);
+  for (const std::string& assignment : args.assignments) registry.SetAssignment(assignment);
+  options.Check();
 
   std::vector<tracker::HandJointsRow> gt_joints;
   std::string object = args.object;
@@ -218,6 +223,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 50));
   app.add_option("--frames", args.max_frames, "stop after this many frames (0: all)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--set", args.assignments,
+                 "set one of inhandscan's options: NAME=VALUE (repeatable; `inhandscan config` "
+                 "lists them)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;

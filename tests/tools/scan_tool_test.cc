@@ -61,6 +61,14 @@ TEST(ScanToolTest, BadInputAndOptionsGetOneLineErrors) {
       RunTool("x.oni --contacts-only --gamma-t 0 --out " + (dir / "o").string());
   EXPECT_EQ(contradiction.exit_code, 2);
   EXPECT_NE(contradiction.err.find("--contacts-only"), std::string::npos);
+  // --set takes inhandscan's options by name, checked before the input is opened.
+  const auto unknown = RunTool("x.oni --set fusion.nothing=1 --out " + (dir / "o").string());
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.err;
+  EXPECT_NE(unknown.err.find("fusion.nothing"), std::string::npos) << unknown.err;
+  const auto negative =
+      RunTool("x.oni --set fusion.icp.anchor_share=-1 --out " + (dir / "o").string());
+  EXPECT_EQ(negative.exit_code, 2) << negative.err;
+  EXPECT_EQ(std::count(negative.err.begin(), negative.err.end(), '\n'), 1) << negative.err;
 }
 
 }  // namespace
