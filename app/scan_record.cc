@@ -74,6 +74,8 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("icp_ms", fused.icp_ms);
     timing("integrate_ms", fused.integrate_ms);
     entry["anchored_contacts"] = fused.anchored_contacts;
+    entry["contact_residual_mm"] = fused.contact_residual_mm;
+    entry["contact_noise_mm"] = fused.contact_noise_mm;
     entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;
     if (fused.pairwise.ok) {
       // The correspondences' motion before ICP: tx ty tz qx qy qz qw (mm), for diagnosis.

@@ -136,6 +136,9 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "a frame turning the object more than this is rejected, degrees");
   r.Add("fusion.anchor_contacts", &u.anchor_contacts,
         "contacts held over frames are anchored at one object point (off: paper's chaining)");
+  r.Add("fusion.contact_noise_reference_mm", &u.contact_noise_reference_mm,
+        "contacts' disagreement at which they hold icp.anchor_share in ICP (scaled by "
+        "1/disagreement^2; 0: fixed share), mm");
   r.Add("fusion.anchor_slip_mm", &u.anchor_slip_mm,
         "a contact farther than this from its anchor has slipped, mm");
   r.Add("fusion.tsdf.size_mm", &u.tsdf.size_mm, "edge of the TSDF cube, mm (paper: 350)");

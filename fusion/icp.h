@@ -24,8 +24,12 @@ struct IcpOptions {
   double min_inlier_fraction = 0.2;
   /// The anchors (contacts) together weigh this share of the surface's point pairs (each in
   /// proportion to its own weight): enough to hold what the surface leaves free (a sphere's
-  /// turn, a cylinder's turn about its axis), too little to pull against what it fixes.
-  double anchor_share = 0.05;
+  /// turn, a cylinder's turn about its axis), too little to pull against what it fixes even
+  /// weakly (a bottle's shoulder fixes its shift along the axis, which tracked fingertips get
+  /// wrong by a millimetre or two from frame to frame). ObjectFusion scales it by how well the
+  /// contacts agree with the registered motion (FusionOptions::contact_noise_reference_mm):
+  /// this is the share at 1 mm of disagreement; the procedural hand's 2.5-2.8 mm gives 0.003.
+  double anchor_share = 0.02;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

@@ -31,6 +31,7 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
   IHS_CHECK_ARG(anchor_slip_mm > 0, "fusion.anchor_slip_mm must be positive");
+  IHS_CHECK_ARG(contact_noise_reference_mm >= 0, "fusion.contact_noise_reference_mm must be >= 0");
   IHS_CHECK_ARG(icp_retry_fraction >= 0 && icp_retry_fraction <= 1,
                 "fusion.icp_retry_fraction must be in [0, 1]");
 }
@@ -38,7 +39,8 @@ void FusionOptions::Check() const {
 ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
     : intrinsics_(intrinsics),
       options_((options.Check(), std::move(options))),
-      volume_(options_.tsdf) {}
+      volume_(options_.tsdf),
+      contact_noise_mm_(options_.contact_noise_reference_mm) {}
 
 int ObjectFusion::ApplyAnchors(const FusionInput& input, PairwiseInput* correspondences) const {
   if (!options_.anchor_contacts || input.contact_ids.empty()) return 0;
@@ -142,10 +144,10 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     // The contacts, where the registration moved them, hold ICP where the surface cannot.
     std::vector<IcpAnchor> anchors;
     if (result.pairwise.ok && options_.pairwise.contact_weight > 0) {
+      const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
       for (const PointMatch& contact : correspondences.contacts) {
-        anchors.push_back({contact.current,
-                           result.pairwise.current_from_previous * contact.previous,
-                           options_.pairwise.contact_weight});
+        anchors.push_back(
+            {contact.current, predicted_step * contact.previous, options_.pairwise.contact_weight});
       }
     }
     // The model is needed only near the object's points: rays start a little in front of them.
@@ -159,13 +161,19 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     }
     const float window =
         static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
+    IcpOptions icp_options = options_.icp;
+    if (options_.contact_noise_reference_mm > 0 && contact_noise_mm_ > 0) {
+      const double ratio = options_.contact_noise_reference_mm / contact_noise_mm_;
+      icp_options.anchor_share *= std::clamp(ratio * ratio, 0.01, 100.0);
+    }
+    result.contact_noise_mm = contact_noise_mm_;
     auto align = [&](const Rigid3& predicted, const std::vector<IcpAnchor>& with) {
       const auto raycast_start = SteadyClock::now();
       volume_.Raycast(intrinsics_, predicted, roi, &near, window, &model_image_);
       const RaycastImage& model = model_image_;
       result.raycast_ms += MillisecondsSince(raycast_start);
       const auto icp_start = SteadyClock::now();
-      IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, options_.icp, with);
+      IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, icp_options, with);
       result.icp_ms += MillisecondsSince(icp_start);
       return icp;
     };
@@ -199,6 +207,22 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     std::snprintf(reason, sizeof reason, "implausible jump: %.1f mm, %.1f° from the last frame",
                   moved, turned);
     return finish(FusionStatus::kSkipped, reason);
+  }
+  // How far the contacts land from the final motion: their noise, for the next frames' weight.
+  // Only where they held ICP (a frame whose registration did without them may have lost the
+  // turn they saw, and that is not their noise).
+  if (!correspondences.contacts.empty() && options_.pairwise.contact_weight > 0 &&
+      result.pairwise.ok && result.icp.ok && !result.icp_from_previous) {
+    std::vector<double> residuals;
+    for (const PointMatch& contact : correspondences.contacts)
+      residuals.push_back((step * contact.previous - contact.current).norm());
+    std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
+    result.contact_residual_mm = residuals[residuals.size() / 2];
+    // A running mean of the per-frame medians over about 20 frames (a frame of bad contacts
+    // moves it a little; a worse tracker moves it for good).
+    if (contact_noise_mm_ > 0) {
+      contact_noise_mm_ += 0.05 * (std::max(0.05, result.contact_residual_mm) - contact_noise_mm_);
+    }
   }
   cam_from_object_ = pose;
   result.cam_from_object = pose;

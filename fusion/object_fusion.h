@@ -43,6 +43,13 @@ struct FusionOptions {
   /// `anchor_slip_mm` from its anchor after registration has slipped and starts anew.
   bool anchor_contacts = true;
   double anchor_slip_mm = 4.0;
+  /// How much the contacts hold ICP follows how well they agree with the registered motion:
+  /// `icp.anchor_share` is their share at `contact_noise_reference_mm` of disagreement (a
+  /// running median of how far the contacts land from where the final pose puts them), and it
+  /// scales with 1/disagreement² (inverse-variance weighting; clamped to 1/100 … 100 times).
+  /// Accurate contacts then decide what the surface leaves weak; noisy ones cannot drag what it
+  /// fixes. 0 keeps `icp.anchor_share` fixed.
+  double contact_noise_reference_mm = 1.0;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -83,6 +90,11 @@ struct FusionResult {
   int integrated_voxels = 0;
   /// Contacts registered against their anchor rather than the previous frame.
   int anchored_contacts = 0;
+  /// The contacts' disagreement with the final pose in this frame (median distance, mm; 0
+  /// without contacts), and the running estimate that weighs them in ICP (see
+  /// FusionOptions::contact_noise_reference_mm).
+  double contact_residual_mm = 0;
+  double contact_noise_mm = 0;
   /// Whether ICP started from the previous pose won over the registration's (see
   /// FusionOptions::icp_retry_fraction).
   bool icp_from_previous = false;
@@ -128,6 +140,9 @@ class ObjectFusion {
   std::vector<std::uint16_t> near_depth_;
   bool started_ = false;
   Rigid3 cam_from_object_;
+  // The running estimate of the contacts' disagreement with the registered motion, mm (starts
+  // at the reference: the configured share until contacts have been seen).
+  double contact_noise_mm_ = 0;
   std::unordered_map<int, Anchor> anchors_;
 };
 
