@@ -77,6 +77,7 @@ void ScanRecord::Add(const FramePacket& packet) {
     entry["contact_residual_mm"] = fused.contact_residual_mm;
     entry["contact_noise_mm"] = fused.contact_noise_mm;
     entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;
+    entry["contacts_rejected"] = fused.pairwise.contacts_rejected;
     if (fused.pairwise.ok) {
       // The correspondences' motion before ICP: tx ty tz qx qy qz qw (mm), for diagnosis.
       const Eigen::Quaterniond q = fused.pairwise.current_from_previous.quaternion();

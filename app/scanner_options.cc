@@ -151,6 +151,8 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "gamma_t, weight of a contact pair against a visual pair (paper: 15; 0: visual only)");
   r.Add("fusion.pairwise.visual_weight", &u.pairwise.visual_weight,
         "weight of visual pairs (0: contacts only)");
+  r.Add("fusion.pairwise.check_contacts", &u.pairwise.check_contacts,
+        "drop contacts that a consistent set of visual matches contradicts");
   r.Add("fusion.pairwise.ransac_iterations", &u.pairwise.ransac_iterations,
         "RANSAC hypotheses over the visual pairs");
   r.Add("fusion.pairwise.inlier_mm", &u.pairwise.inlier_mm, "RANSAC inlier distance, mm");

@@ -145,7 +145,15 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     std::vector<IcpAnchor> anchors;
     if (result.pairwise.ok && options_.pairwise.contact_weight > 0) {
       const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
+      const double inlier_sq = options_.pairwise.inlier_mm * options_.pairwise.inlier_mm;
       for (const PointMatch& contact : correspondences.contacts) {
+        // Where feature matches fixed the motion, a contact they contradict is a mistracked
+        // fingertip (see PairwiseOptions::check_contacts): it must not steer what the surface
+        // leaves free and the features saw (a flat face's sliding).
+        if (options_.pairwise.check_contacts && result.pairwise.visual_inliers > 0 &&
+            (predicted_step * contact.previous - contact.current).squaredNorm() > inlier_sq) {
+          continue;
+        }
         anchors.push_back(
             {contact.current, predicted_step * contact.previous, options_.pairwise.contact_weight});
       }

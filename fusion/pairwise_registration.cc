@@ -98,11 +98,26 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     visual.insert(visual.end(), input.features_3d.begin(), input.features_3d.end());
     visual = RansacInliers(visual, options);
   }
-  const double spread = Spread(input.contacts);
+  // Contacts that a consistent visual set contradicts are a mistracked hand's, not the object's:
+  // each counts γt times, and hundreds of them would outweigh every good feature match.
+  std::vector<PointMatch> contacts;
+  if (options.check_contacts && !visual.empty() && options.contact_weight > 0) {
+    std::vector<Eigen::Vector3d> from, to;
+    for (const PointMatch& m : visual) from.push_back(m.previous), to.push_back(m.current);
+    const Rigid3 seen = FitRigidTransform(from, to);
+    const double inlier_sq = options.inlier_mm * options.inlier_mm;
+    for (const PointMatch& m : input.contacts) {
+      if ((seen * m.previous - m.current).squaredNorm() < inlier_sq) contacts.push_back(m);
+    }
+    result.contacts_rejected = static_cast<int>(input.contacts.size() - contacts.size());
+  } else {
+    contacts = input.contacts;
+  }
+  const double spread = Spread(contacts);
   result.contact_spread_mm = spread;
   const bool use_contacts = options.contact_weight > 0 && spread >= options.min_contact_spread_mm &&
-                            (static_cast<int>(input.contacts.size()) >= options.min_contacts ||
-                             (!visual.empty() && !input.contacts.empty()));
+                            (static_cast<int>(contacts.size()) >= options.min_contacts ||
+                             (!visual.empty() && !contacts.empty()));
   if (visual.empty() && !use_contacts) {
     result.reason = "too few correspondences: " + std::to_string(input.features_2d.size()) +
                     " 2D and " + std::to_string(input.features_3d.size()) +
@@ -121,7 +136,7 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     from.push_back(m.previous), to.push_back(m.current), weights.push_back(options.visual_weight);
   }
   if (use_contacts) {
-    for (const PointMatch& m : input.contacts) {
+    for (const PointMatch& m : contacts) {
       from.push_back(m.previous), to.push_back(m.current);
       weights.push_back(options.contact_weight);
     }
@@ -132,7 +147,7 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     sum += (result.current_from_previous * from[i] - to[i]).squaredNorm();
   result.rms_mm = std::sqrt(sum / from.size());
   result.visual_inliers = static_cast<int>(visual.size());
-  result.contacts = use_contacts ? static_cast<int>(input.contacts.size()) : 0;
+  result.contacts = use_contacts ? static_cast<int>(contacts.size()) : 0;
   result.ok = true;
   return result;
 }

@@ -44,6 +44,10 @@ struct PairwiseOptions {
   /// in the previous frame, mm): one fingertip's patch (the paper asks for two contact bones)
   /// pins a point of the object, not its turn.
   double min_contact_spread_mm = 20.0;
+  /// With a consistent visual set, contacts farther than `inlier_mm` from where its motion puts
+  /// them are dropped (a mistracked fingertip; γt times hundreds of contact vertices would
+  /// outweigh every feature match).
+  bool check_contacts = true;
   /// Seed of the RANSAC sampling (results are deterministic).
   std::uint32_t seed = 1;
 
@@ -61,6 +65,8 @@ struct PairwiseResult {
   /// Pairs used: visual inliers and contacts.
   int visual_inliers = 0;
   int contacts = 0;
+  /// Contacts dropped because the visual inliers contradict them (PairwiseOptions::check_contacts).
+  int contacts_rejected = 0;
   /// The contacts' spread (see PairwiseOptions::min_contact_spread_mm), mm.
   double contact_spread_mm = 0;
   /// Root mean square distance of the used pairs after the solve, mm.
