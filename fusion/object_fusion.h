@@ -45,7 +45,8 @@ struct FusionOptions {
   double anchor_slip_mm = 4.0;
   /// How much the contacts hold ICP follows how well they agree with the registered motion:
   /// `icp.anchor_share` is their share at `contact_noise_reference_mm` of disagreement (a
-  /// running median of how far the contacts land from where the final pose puts them), and it
+  /// running mean of each frame's median distance between the contacts and where the final pose
+  /// puts them, over about 20 frames where the contacts held ICP), and it
   /// scales with 1/disagreement² (inverse-variance weighting; clamped to 1/100 … 100 times).
   /// Accurate contacts then decide what the surface leaves weak; noisy ones cannot drag what it
   /// fixes. 0 keeps `icp.anchor_share` fixed.
