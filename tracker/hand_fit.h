@@ -21,8 +21,9 @@ namespace ihs::tracker {
 struct HandFitOptions {
   /// γc, weight of the collision term (paper: 10).
   double collision_weight = 10.0;
-  /// Correspondence updates per frame, and Levenberg–Marquardt iterations per update.
-  int outer_iterations = 4;
+  /// Correspondence updates per frame, and Levenberg–Marquardt iterations per update (three
+  /// updates suffice with the data points below; see max_data_points).
+  int outer_iterations = 3;
   int inner_iterations = 5;
   /// An inner solve also stops once an iteration lowers its cost by less than this fraction
   /// (Ceres' function tolerance; its own default is 1e-6). Its correspondences are found anew
@@ -32,8 +33,13 @@ struct HandFitOptions {
   /// joint error grew by 2–3 mm.
   double inner_function_tolerance = 1e-2;
   /// Data points matched to the model (data → model) and visible model points matched to the
-  /// data (model → data), at most; both are subsampled evenly.
-  int max_data_points = 200;
+  /// data (model → data), at most; both are subsampled evenly. Which data points a stride picks
+  /// changes from frame to frame, and with few of them the fingers jitter by that: with 500
+  /// instead of 200 (and three updates instead of four) the contact error's median fell from
+  /// 1.55–1.89 to 1.12–1.43 mm on the four recorded sessions and from 1.44–1.60 to 1.09–1.30 mm
+  /// on four other object × motion stretches, the joint error stayed within ±1 mm and the
+  /// frame took about 1 ms longer. More model points did not help.
+  int max_data_points = 500;
   int max_model_points = 200;
   /// Pairs farther apart than this are dropped, mm.
   double max_correspondence_mm = 40.0;
