@@ -37,8 +37,8 @@ struct HandFitOptions {
   /// changes from frame to frame, and with few of them the fingers jitter by that: with 500
   /// instead of 200 (and three updates instead of four) the contact error's median fell from
   /// 1.55–1.89 to 1.12–1.43 mm on the four recorded sessions and from 1.44–1.60 to 1.09–1.30 mm
-  /// on four other object × motion stretches, the joint error stayed within ±1 mm and the
-  /// frame took about 1 ms longer. More model points did not help.
+  /// on four other object × motion stretches, the joint error moved by −1.2 to +0.8 mm per
+  /// sequence and the frame took about 1 ms longer. More model points did not help.
   int max_data_points = 500;
   int max_model_points = 200;
   /// Pairs farther apart than this are dropped, mm.
