@@ -170,6 +170,9 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "ICP with fewer pairs than this share of points is not trusted");
   r.Add("fusion.icp.anchor_share", &u.icp.anchor_share,
         "share of the surface pairs' weight the contact anchors carry in ICP");
+  r.Add("fusion.icp.min_constraint_over_noise", &u.icp.min_constraint_over_noise,
+        "without anchors, ICP leaves directions the surface constrains less than this many times "
+        "its normals' noise at the prediction (0: solves all)");
 
   fusion::MeshingOptions& m = options->meshing;
   r.Add("mesh.min_component_fraction", &m.min_component_fraction,

@@ -1,6 +1,7 @@
 #include "fusion/icp.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -14,6 +15,7 @@ void IcpOptions::Check() const {
   IHS_CHECK_ARG(min_inlier_fraction >= 0 && min_inlier_fraction <= 1,
                 "icp.min_inlier_fraction must be in [0, 1]");
   IHS_CHECK_ARG(anchor_share >= 0, "icp.anchor_share must be >= 0");
+  IHS_CHECK_ARG(min_constraint_over_noise >= 0, "icp.min_constraint_over_noise must be >= 0");
 }
 
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
@@ -33,19 +35,32 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   const double max_sq = options.max_distance_mm * options.max_distance_mm;
   double rms = 0;
   int inliers = 0;
-  // The twist is taken about the points' centroid, with the turn scaled by their spread, so
-  // that turns and shifts weigh alike and a sphere's free turn is a clean null direction.
+  // The twist is taken about a pivot (first the points' centroid), with the turn scaled by the
+  // points' spread about it, so that turns and shifts weigh alike.
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3f& point : points) centroid += point.cast<double>();
   centroid /= std::max<size_t>(1, points.size());
   double spread_sq = 0;
   for (const Eigen::Vector3f& point : points)
     spread_sq += (point.cast<double>() - centroid).squaredNorm();
-  const double scale = std::max(1.0, std::sqrt(spread_sq / std::max<size_t>(1, points.size())));
+  spread_sq /= std::max<size_t>(1, points.size());
+  Eigen::Vector3d pivot = centroid;
+  double scale = std::max(1.0, std::sqrt(spread_sq));
+  // Without anchors, the directions the surface leaves free keep the prediction
+  // (IcpOptions::min_constraint_over_noise).
+  const bool keep_free = anchors.empty() && options.min_constraint_over_noise > 0;
+  std::vector<double> normal_jitter;
+  // What a direction of the motion learns per point pair from the model's normal noise alone.
+  double noise_information = 0;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
     Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
-    const Eigen::Vector3d centre = correction * centroid;
+    Eigen::Vector3d centre = correction * pivot;
+    // Where the model's normal lines meet (least squares): Σ(I − nnᵀ)·x = Σ(I − nnᵀ)·p.
+    const bool find_pivot = keep_free && iteration == 0;
+    Eigen::Matrix3d across = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d across_points = Eigen::Vector3d::Zero();
+    if (find_pivot) normal_jitter.clear();
     double sum_sq = 0;
     inliers = 0;
     for (const Eigen::Vector3f& point : points) {
@@ -70,8 +85,52 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       rhs -= row * residual;
       sum_sq += residual * residual;
       ++inliers;
+      if (find_pivot) {
+        // The model's normal noise: half the squared difference to the next pixel's normal on
+        // the same surface.
+        const size_t next = index + 1;
+        if (u + 1 < model.width && model.depth_mm[next] > 0 &&
+            std::abs(model.depth_mm[next] - depth) < 2 * options.max_distance_mm) {
+          normal_jitter.push_back(0.5 *
+                                  (model.normals[next].cast<double>() - normal).squaredNorm());
+        }
+        const Eigen::Matrix3d off_normal =
+            Eigen::Matrix3d::Identity() - normal * normal.transpose();
+        across += off_normal;
+        across_points += off_normal * p;
+      }
     }
     normal_matrix.triangularView<Eigen::StrictlyLower>() = normal_matrix.transpose();
+    if (find_pivot && inliers >= 6) {
+      // The surface's free turns (a sphere's, a bottle's about its axis) are turns about where
+      // its normal lines meet: taken about that point, they are pure turns, so keeping them at the
+      // prediction does not turn the object when its position is corrected. Where the lines do
+      // not meet (a plane), the pivot stays near the centroid.
+      const double pull = 1e-3 * across.trace();
+      const Eigen::Vector3d meet =
+          (across + pull * Eigen::Matrix3d::Identity()).ldlt().solve(across_points + pull * centre);
+      if (meet.allFinite() && (meet - centre).norm() < 3 * scale) {
+        // Rows about the new pivot are T·rows: ((p − c′) × n) / s′ = (s/s′)·((p − c) × n) / s
+        // + ((c − c′) × n) / s′.
+        const double new_scale =
+            std::max(1.0, std::sqrt(spread_sq + (meet - centre).squaredNorm()));
+        Eigen::Matrix<double, 6, 6> to_pivot = Eigen::Matrix<double, 6, 6>::Identity();
+        to_pivot.topLeftCorner<3, 3>() *= scale / new_scale;
+        const Eigen::Vector3d d = centre - meet;
+        to_pivot.topRightCorner<3, 3>() << 0, -d.z(), d.y(), d.z(), 0, -d.x(), -d.y(), d.x(), 0;
+        to_pivot.topRightCorner<3, 3>() /= new_scale;
+        normal_matrix = to_pivot * normal_matrix * to_pivot.transpose();
+        rhs = to_pivot * rhs;
+        pivot = meet;  // The correction is the identity in the first iteration.
+        centre = meet;
+        scale = new_scale;
+      }
+      if (!normal_jitter.empty()) {
+        auto middle = normal_jitter.begin() + normal_jitter.size() / 2;
+        std::nth_element(normal_jitter.begin(), middle, normal_jitter.end());
+        noise_information = *middle;
+      }
+    }
     rms = inliers > 0 ? std::sqrt(sum_sq / inliers) : 0;
     // The anchors together weigh `anchor_share` of the surface's pairs: they decide what the
     // surface leaves open (a sphere's turn) and hardly move what it fixes.
@@ -95,7 +154,21 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
     // prediction put them.
     normal_matrix.diagonal() *= 1.0 + 1e-4;
     normal_matrix.diagonal().array() += 1e-9;
-    const Eigen::Matrix<double, 6, 1> step = normal_matrix.ldlt().solve(rhs);
+    Eigen::Matrix<double, 6, 1> step;
+    if (keep_free && noise_information > 0) {
+      // Only the directions the surface constrains move; the others keep the prediction.
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(normal_matrix);
+      const double floor = options.min_constraint_over_noise * noise_information * inliers;
+      step.setZero();
+      for (int i = 0; i < 6; ++i) {
+        const double value = eigen.eigenvalues()[i];
+        if (value <= floor || value <= 0) continue;
+        const auto direction = eigen.eigenvectors().col(i);
+        step += direction * (direction.dot(rhs) / value);
+      }
+    } else {
+      step = normal_matrix.ldlt().solve(rhs);
+    }
     if (!step.allFinite()) break;
     const Rigid3 turn = Rigid3::FromRotationVector(step.head<3>() / scale, Eigen::Vector3d::Zero());
     correction = Rigid3::Translation(centre + step.tail<3>()) * turn *

@@ -30,6 +30,19 @@ struct IcpOptions {
   /// contacts agree with the registered motion (FusionOptions::contact_noise_reference_mm):
   /// this is the share at 1 mm of disagreement; the procedural hand's 2.5-2.8 mm gives 0.003.
   double anchor_share = 0.02;
+  /// Without anchors, a direction of the motion that the surface constrains (per point pair)
+  /// less than this many times its model's normal noise does (half the median squared
+  /// difference of neighbouring normals) keeps the prediction: a sphere's three turns, a
+  /// bottle's turn about its axis. There the model's small flaws, not the object's motion, would
+  /// decide, and they spun a sphere by about 4° per frame that the truth turned by 0.1°. Turns
+  /// are taken about where the model's normal lines meet (a sphere's centre, a point on a
+  /// bottle's axis), so keeping them does not turn the object when its position is corrected.
+  /// Measured ratios of free directions: 0.1-1.4 (10th-90th percentile; the sphere, bottle and
+  /// pin sessions), 0.5-1.9 (rendered spheres in tests); of real ones: 6 and more (a bottle's
+  /// shift along its axis), 2.6 and more (90 % of a textured box's frames), but 1.4-2.5 for the
+  /// turn a noiseless 45 x 30 x 18 mm ellipsoid's cap fixes only weakly: 1.5 is a compromise,
+  /// and a weakly fixed turn then keeps the prediction. 0 solves every direction.
+  double min_constraint_over_noise = 1.5;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
