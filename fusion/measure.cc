@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "core/check.h"
@@ -175,6 +176,42 @@ static RevolutionMeasures MeasureAlong(
   return result;
 }
 
+// The direction of the line that the surface's normal lines meet best (every normal of a body of
+// revolution meets its axis): with the axis's Plücker coordinates (a, q × a), q a point on it,
+// the normal n at p meets it when n·(q × a) + (p × n)·a = 0. The area-weighted least squares
+// over the faces (p taken from `origin`, for conditioning), with |a| = 1, is the smallest
+// eigenvector of the system reduced to a. None for a degenerate surface (a sphere's normals meet
+// every line through its centre; then any axis will do anyway).
+static std::optional<Eigen::Vector3d> NormalsMeet(const TriangleMesh& mesh,
+                                                  const Eigen::Vector3d& origin) {
+  Eigen::Matrix<double, 6, 6> system = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>() - origin;
+    const Eigen::Vector3d b = mesh.vertices[f[1]].cast<double>() - origin;
+    const Eigen::Vector3d c = mesh.vertices[f[2]].cast<double>() - origin;
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const double twice_area = cross.norm();
+    if (twice_area <= 0) continue;
+    const Eigen::Vector3d n = cross / twice_area;
+    Eigen::Matrix<double, 6, 1> row;
+    row << ((a + b + c) / 3).cross(n), n;
+    system += 0.5 * twice_area * row * row.transpose();
+  }
+  const Eigen::Matrix3d turn = system.topLeftCorner<3, 3>();
+  const Eigen::Matrix3d mixed = system.topRightCorner<3, 3>();
+  const Eigen::Matrix3d shift = system.bottomRightCorner<3, 3>();
+  if (!(shift.trace() > 0)) return std::nullopt;
+  const Eigen::Matrix3d reduced =
+      turn - mixed * (shift + 1e-9 * shift.trace() * Eigen::Matrix3d::Identity())
+                         .ldlt()
+                         .solve(mixed.transpose());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(reduced);
+  const Eigen::Vector3d values = solver.eigenvalues();
+  // A clear smallest direction (a sphere's three are alike).
+  if (!values.allFinite() || values[0] > 0.1 * values[1]) return std::nullopt;
+  return solver.eigenvectors().col(0).normalized();
+}
+
 RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) {
   IHS_CHECK_ARG(slice_mm > 0, "slice_mm must be positive, got " << slice_mm);
   const std::vector<Face> faces = Faces(mesh);
@@ -192,14 +229,16 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
     covariance += f.area * d * d.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance / total_area);
-  // The axis: of the three principal axes, the one about which the surface is most nearly a
-  // body of revolution (its sections fit circles best). The spread alone misleads on squat
-  // objects seen in part.
+  // The axis: of the three principal axes and the line the surface's normals meet, the one about
+  // which the surface is most nearly a body of revolution (its sections fit circles best). The
+  // spread alone misleads on squat objects and on surfaces seen in part.
+  std::vector<Eigen::Vector3d> candidates;
+  for (int k = 0; k < 3; ++k) candidates.push_back(solver.eigenvectors().col(k).normalized());
+  if (const auto normals_meet = NormalsMeet(mesh, centre)) candidates.push_back(*normals_meet);
   double best = INFINITY;
-  for (int k = 0; k < 3; ++k) {
+  for (const Eigen::Vector3d& axis : candidates) {
     double residual = INFINITY;
-    RevolutionMeasures candidate =
-        MeasureAlong(mesh, centre, solver.eigenvectors().col(k).normalized(), slice_mm, &residual);
+    RevolutionMeasures candidate = MeasureAlong(mesh, centre, axis, slice_mm, &residual);
     if (residual < best) best = residual, result = std::move(candidate);
   }
   // The principal axis of a surface seen in part (or of a squat body) can be tilted by a degree

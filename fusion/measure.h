@@ -30,14 +30,15 @@ struct RevolutionMeasures {
   std::vector<std::pair<double, double>> profile;
 };
 
-/// Measures `mesh` as a body of revolution. The axis is first the principal axis about which the
-/// sections fit circles best (the long axis of a bottle, the short one of a flat disc; any for a
-/// sphere), then the line through the sections' circle centres (a surface seen in part tilts its
-/// principal axes; the centres stay on the symmetry axis). Each section's diameter is that of the
-/// least-squares circle through its vertices (weighted by the area of their side faces; faces
-/// turned along the axis, such as flat caps, do not count), so that a section seen only in part
-/// still measures right. Throws std::invalid_argument for an empty mesh or a non-positive
-/// `slice_mm`.
+/// Measures `mesh` as a body of revolution. The axis is first, of the principal axes and the line
+/// the surface's normal lines meet best (every normal of a body of revolution meets its axis),
+/// the one about which the sections fit circles best (the long axis of a bottle, the short one of
+/// a flat disc; any for a sphere), then the line through the sections' circle centres (a surface
+/// seen in part tilts its principal axes; the centres stay on the symmetry axis). Each section's
+/// diameter is that of the least-squares circle through its vertices (weighted by the area of their
+/// side faces; faces turned along the axis, such as flat caps, do not count), so that a section
+/// seen only in part still measures right. Throws std::invalid_argument for an empty mesh or a
+/// non-positive `slice_mm`.
 RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm = 2.0);
 
 /// How well a scanned surface matches the true one (both in the same frame, mm).

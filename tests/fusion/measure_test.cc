@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "tests/mesh_fixtures.h"
@@ -26,6 +27,29 @@ TriangleMesh PaperObject(const std::string& name) {
       Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).toRotationMatrix();
   for (auto& v : mesh.vertices) v = turn * v + Eigen::Vector3f(12, -40, 610);
   return mesh;
+}
+
+// The faces of `whole` that `keep` (given a face's centroid and its normal) keeps.
+template <typename Keep>
+TriangleMesh KeepFaces(const TriangleMesh& whole, Keep keep) {
+  TriangleMesh kept;
+  std::vector<int> index(whole.vertices.size(), -1);
+  for (const auto& f : whole.faces) {
+    const Eigen::Vector3d a = whole.vertices[f[0]].cast<double>();
+    const Eigen::Vector3d b = whole.vertices[f[1]].cast<double>();
+    const Eigen::Vector3d c = whole.vertices[f[2]].cast<double>();
+    if (!keep((a + b + c) / 3, (b - a).cross(c - a))) continue;
+    std::array<int, 3> face;
+    for (int k = 0; k < 3; ++k) {
+      if (index[f[k]] < 0) {
+        index[f[k]] = static_cast<int>(kept.vertices.size());
+        kept.vertices.push_back(whole.vertices[f[k]]);
+      }
+      face[k] = index[f[k]];
+    }
+    kept.faces.push_back(face);
+  }
+  return kept;
 }
 
 TEST(MeasureTest, ThePaperObjectsMeasureToTheirDimensions) {
@@ -76,28 +100,41 @@ TEST(MeasureTest, TheAxisOfAHalfSeenSquatBottleIsItsSymmetryAxis) {
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   const Eigen::Vector3d true_axis = turn.col(2);
   const Eigen::Vector3d side = turn.col(0);
-  TriangleMesh seen;
-  std::vector<int> index(whole.vertices.size(), -1);
-  for (const auto& f : whole.faces) {
-    const Eigen::Vector3d c =
-        ((whole.vertices[f[0]] + whole.vertices[f[1]] + whole.vertices[f[2]]) / 3).cast<double>() -
-        Eigen::Vector3d(12, -40, 610);
-    if (c.dot(side) < 0 || c.dot(true_axis) < 1.0) continue;
-    std::array<int, 3> face;
-    for (int k = 0; k < 3; ++k) {
-      if (index[f[k]] < 0) {
-        index[f[k]] = static_cast<int>(seen.vertices.size());
-        seen.vertices.push_back(whole.vertices[f[k]]);
-      }
-      face[k] = index[f[k]];
-    }
-    seen.faces.push_back(face);
-  }
+  const TriangleMesh seen =
+      KeepFaces(whole, [&](const Eigen::Vector3d& centroid, const Eigen::Vector3d&) {
+        const Eigen::Vector3d c = centroid - Eigen::Vector3d(12, -40, 610);
+        return c.dot(side) >= 0 && c.dot(true_axis) >= 1.0;
+      });
   const RevolutionMeasures m = MeasureRevolution(seen);
   // Measured: 0.01° off the axis, height 79.00 mm (80 less the 1 mm of bottom left out); the
   // principal axis alone was 6.2° off and measured 81.24 mm.
   EXPECT_GT(std::abs(m.axis.dot(true_axis)), std::cos(0.3 * M_PI / 180));
   EXPECT_NEAR(m.height_mm, 79, 0.5);
+  EXPECT_NEAR(m.widest_diameter_mm, 52, 0.5);
+}
+
+TEST(MeasureTest, ASmallBottleSeenFromBelowOnOneSideMeasuresItsHeight) {
+  // What a camera sees of the small bottle from 40° below its base on one side (the faces
+  // turned towards it): half of the side and the bottom, as in a scan that never turned the
+  // bottle. Its principal axes tilt by more than the sections' centres can correct: measured
+  // 12.7° off the axis and 85.96 mm high without the line the normals meet, 0.02° and 80.02 mm
+  // with it. (On such a scan, the unseen stretch u4 in docs/fusion.md: 16° off, +6.9 mm.)
+  const TriangleMesh whole = PaperObject("small-bottle");
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Vector3d true_axis = turn.col(2);
+  const Eigen::Vector3d towards_camera =
+      turn * Eigen::Vector3d(std::cos(40 * M_PI / 180), 0, -std::sin(40 * M_PI / 180));
+  const TriangleMesh seen =
+      KeepFaces(whole, [&](const Eigen::Vector3d&, const Eigen::Vector3d& normal) {
+        return normal.dot(towards_camera) > 0;
+      });
+  const RevolutionMeasures m = MeasureRevolution(seen);
+  std::printf("%.2f° off the axis, height %.2f mm, widest %.2f mm\n",
+              std::acos(std::min(1.0, std::abs(m.axis.dot(true_axis)))) * 180 / M_PI, m.height_mm,
+              m.widest_diameter_mm);
+  EXPECT_GT(std::abs(m.axis.dot(true_axis)), std::cos(1.0 * M_PI / 180));
+  EXPECT_NEAR(m.height_mm, 80, 0.5);
   EXPECT_NEAR(m.widest_diameter_mm, 52, 0.5);
 }
 
