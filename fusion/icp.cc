@@ -60,7 +60,7 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
     const bool find_pivot = keep_free && iteration == 0;
     Eigen::Matrix3d across = Eigen::Matrix3d::Zero();
     Eigen::Vector3d across_points = Eigen::Vector3d::Zero();
-    if (find_pivot) normal_jitter.clear();
+    if (find_pivot) normal_jitter.reserve(points.size());
     double sum_sq = 0;
     inliers = 0;
     for (const Eigen::Vector3f& point : points) {

@@ -13,10 +13,11 @@
 namespace ihs::fusion {
 namespace {
 
-// A mesh's faces as centroids with their areas.
+// A mesh's faces as centroids with their areas and unit normals.
 struct Face {
   Eigen::Vector3d centroid;
   double area;
+  Eigen::Vector3d normal;
 };
 
 std::vector<Face> Faces(const TriangleMesh& mesh) {
@@ -29,7 +30,7 @@ std::vector<Face> Faces(const TriangleMesh& mesh) {
     const Eigen::Vector3d cross = (b - a).cross(c - a);
     const double twice_area = cross.norm();
     if (twice_area <= 0) continue;
-    faces.push_back({(a + b + c) / 3, 0.5 * twice_area});
+    faces.push_back({(a + b + c) / 3, 0.5 * twice_area, cross / twice_area});
   }
   return faces;
 }
@@ -182,20 +183,13 @@ static RevolutionMeasures MeasureAlong(
 // over the faces (p taken from `origin`, for conditioning), with |a| = 1, is the smallest
 // eigenvector of the system reduced to a. None for a degenerate surface (a sphere's normals meet
 // every line through its centre; then any axis will do anyway).
-static std::optional<Eigen::Vector3d> NormalsMeet(const TriangleMesh& mesh,
+static std::optional<Eigen::Vector3d> NormalsMeet(const std::vector<Face>& faces,
                                                   const Eigen::Vector3d& origin) {
   Eigen::Matrix<double, 6, 6> system = Eigen::Matrix<double, 6, 6>::Zero();
-  for (const auto& f : mesh.faces) {
-    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>() - origin;
-    const Eigen::Vector3d b = mesh.vertices[f[1]].cast<double>() - origin;
-    const Eigen::Vector3d c = mesh.vertices[f[2]].cast<double>() - origin;
-    const Eigen::Vector3d cross = (b - a).cross(c - a);
-    const double twice_area = cross.norm();
-    if (twice_area <= 0) continue;
-    const Eigen::Vector3d n = cross / twice_area;
+  for (const Face& f : faces) {
     Eigen::Matrix<double, 6, 1> row;
-    row << ((a + b + c) / 3).cross(n), n;
-    system += 0.5 * twice_area * row * row.transpose();
+    row << (f.centroid - origin).cross(f.normal), f.normal;
+    system += f.area * row * row.transpose();
   }
   const Eigen::Matrix3d turn = system.topLeftCorner<3, 3>();
   const Eigen::Matrix3d mixed = system.topRightCorner<3, 3>();
@@ -234,7 +228,7 @@ RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) 
   // spread alone misleads on squat objects and on surfaces seen in part.
   std::vector<Eigen::Vector3d> candidates;
   for (int k = 0; k < 3; ++k) candidates.push_back(solver.eigenvectors().col(k).normalized());
-  if (const auto normals_meet = NormalsMeet(mesh, centre)) candidates.push_back(*normals_meet);
+  if (const auto normals_meet = NormalsMeet(faces, centre)) candidates.push_back(*normals_meet);
   double best = INFINITY;
   for (const Eigen::Vector3d& axis : candidates) {
     double residual = INFINITY;
