@@ -143,7 +143,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
                                     box[3] + margin};
     // The contacts, where the registration moved them, hold ICP where the surface cannot.
     std::vector<IcpAnchor> anchors;
-    if (result.pairwise.ok && options_.pairwise.contact_weight > 0) {
+    if (result.pairwise.ok && options_.pairwise.contact_weight > 0 &&
+        result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm) {
       const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
       const double inlier_sq = options_.pairwise.inlier_mm * options_.pairwise.inlier_mm;
       for (const PointMatch& contact : correspondences.contacts) {

@@ -50,16 +50,29 @@ Contacts ContactDetector::Detect(const std::vector<Eigen::Vector3f>& posed_verti
                                                                                 : 1e9f);
     }
   }
-  for (double threshold = options_.start_mm; threshold <= options_.max_mm + 1e-9;
-       threshold += options_.step_mm) {
-    contacts.bones.clear();
-    contacts.threshold_mm = threshold;
+  auto bones_within = [&](double threshold) {
+    std::vector<int> bones;
     for (size_t e = 0; e < end_effectors_.size(); ++e) {
       const auto close = std::count_if(distances[e].begin(), distances[e].end(),
                                        [&](float d) { return d <= threshold; });
-      if (close > min_vertices_[e]) contacts.bones.push_back(end_effectors_[e]);
+      if (close > min_vertices_[e]) bones.push_back(end_effectors_[e]);
     }
-    if (static_cast<int>(contacts.bones.size()) >= options_.min_bones) break;
+    return bones;
+  };
+  contacts.bones = bones_within(options_.start_mm);
+  contacts.threshold_mm = options_.start_mm;
+  // The threshold grows only to find the grasp's fingertips together; where it does not, a
+  // fingertip counts only at the first threshold (a lone fingertip a few millimetres away is
+  // a hovering finger as often as a touching one).
+  for (double threshold = options_.start_mm + options_.step_mm;
+       static_cast<int>(contacts.bones.size()) < options_.min_bones &&
+       threshold <= options_.max_mm + 1e-9;
+       threshold += options_.step_mm) {
+    std::vector<int> bones = bones_within(threshold);
+    if (static_cast<int>(bones.size()) >= options_.min_bones) {
+      contacts.bones = std::move(bones);
+      contacts.threshold_mm = threshold;
+    }
   }
   for (size_t e = 0; e < end_effectors_.size(); ++e) {
     if (std::find(contacts.bones.begin(), contacts.bones.end(), end_effectors_[e]) ==
