@@ -60,6 +60,9 @@ int main(int argc, char** argv) {
   app.add_flag("--left-hand", options.left_hand,
                "a left hand (scripted motion; the procedural hand mirrored)");
   app.add_option("--frames", frames, "frame range A:B of the motion (default: all)");
+  app.add_option("--frame-step", options.frame_step,
+                 "render every Nth frame of the range: the motion N times as fast")
+      ->check(CLI::Range(1, 10));
   app.add_option("--seed", options.seed, "seed of every random choice")->capture_default_str();
   app.add_flag("--no-noise", no_noise, "an ideal sensor (depth rounded to mm, nothing else)");
   app.add_option("--slip-mm", slip_mm, "contacts slide this much per held frame (random walk)")

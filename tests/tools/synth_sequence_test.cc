@@ -185,6 +185,28 @@ TEST(SynthSequenceTest, SameSeedSameBytesOtherSeedOtherNoise) {
             test::ReadFileString(dir / "c" / "sequence.oni"));
 }
 
+TEST(SynthSequenceTest, AFrameStepRendersEveryNthFrameOfTheSameMotion) {
+  SequenceOptions options = ShortSequence();
+  options.sensor = SensorModelOptions::Ideal();
+  SequenceRenderer every(options);
+  options.frame_step = 3;
+  SequenceRenderer third(options);
+  ASSERT_EQ(every.frame_count(), 24);
+  ASSERT_EQ(third.frame_count(), 8);
+  for (int i : {1, 5, 7}) {
+    const RenderedFrame fast = third.Render(i), slow = every.Render(3 * i);
+    EXPECT_LT((fast.cam_from_object.translation() - slow.cam_from_object.translation()).norm(),
+              1e-9);
+    EXPECT_TRUE(fast.cam_from_object.rotation().isApprox(slow.cam_from_object.rotation(), 1e-12));
+    EXPECT_LT((fast.joints_mm[20] - slow.joints_mm[20]).norm(), 1e-9);
+    // The frame keeps its place in the faster sequence: index and time.
+    EXPECT_EQ(fast.frame.index, i);
+    EXPECT_EQ(fast.frame.depth_timestamp_us, std::llround(i * 1e6 / options.fps));
+  }
+  options.frame_step = 0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
 test::CommandResult RunTool(const std::string& arguments) {
   return test::RunCommand(std::string(IHS_SYNTH_TOOL) + " " + arguments);
 }

@@ -76,6 +76,7 @@ void SequenceOptions::Check() const {
   IHS_CHECK_ARG(first_frame >= 0, "frames: the first frame must be >= 0");
   IHS_CHECK_ARG(last_frame == -1 || last_frame >= first_frame,
                 "frames: the last frame must not come before the first");
+  IHS_CHECK_ARG(frame_step >= 1 && frame_step <= 10, "frame step must be in [1, 10]");
   IHS_CHECK_ARG(fps > 0 && fps <= 1000, "fps must be in (0, 1000]");
   IHS_CHECK_ARG(touch_mm > 0, "touch_mm must be positive");
   IHS_CHECK_ARG(motion == "scripted" || motion.rfind("recorded:", 0) == 0,
@@ -128,7 +129,7 @@ SequenceRenderer::~SequenceRenderer() = default;
 
 RenderedFrame SequenceRenderer::Render(int i) {
   IHS_CHECK_ARG(i >= 0 && i < frame_count(), "frame " << i << " outside 0:" << frame_count() - 1);
-  const MotionFrame& m = motion_.frames[options_.first_frame + i];
+  const MotionFrame& m = motion_.frames[options_.first_frame + i * options_.frame_step];
   RenderedFrame out;
   out.posed_hand = hand_.Pose(m.cam_from_bone);
   const render::RenderItem hand_item{&out.posed_hand, Rigid3(), options_.hand_rgb, false,
@@ -159,7 +160,8 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
   const HandObjectGeometry& geometry = renderer.geometry();
   const RecordedMotionReport& recorded_report = renderer.recorded_report();
   const bool recorded = options.motion != "scripted";
-  const int last = options.first_frame + renderer.frame_count() - 1;
+  const int count = renderer.frame_count();
+  const int last = options.first_frame + (count - 1) * options.frame_step;
 
   // Outputs.
   const fs::path gt = out / "gt";
@@ -188,7 +190,6 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
   contacts_csv += ",penetration_mm\n";
 
   SequenceSummary summary;
-  const int count = last - options.first_frame + 1;
   std::vector<int> sheet_frames;
   // Fractions of the sequence that fall on different phases of a periodic motion.
   for (double fraction : {0.1, 0.3, 0.55, 0.85}) {
@@ -283,7 +284,11 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
       {"hand", options.hand},
       {"hand_scale", options.hand_scale},
       {"hand_bones", bone_names.size()},
-      {"frames", {{"first", options.first_frame}, {"last", last}, {"count", count}}},
+      {"frames",
+       {{"first", options.first_frame},
+        {"last", last},
+        {"step", options.frame_step},
+        {"count", count}}},
       {"seed", options.seed},
       {"fps", options.fps},
       {"touch_mm", options.touch_mm},

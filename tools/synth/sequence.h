@@ -54,6 +54,10 @@ struct SequenceOptions {
   /// Frames [first_frame, last_frame] of the motion (last_frame −1: to the end).
   int first_frame = 0;
   int last_frame = -1;
+  /// Every `frame_step`-th frame of that range is rendered, with timestamps `fps` apart: the
+  /// same motion made `frame_step` times as fast (the object turns that much more between
+  /// frames), or a camera that drops frames.
+  int frame_step = 1;
   /// Seed of every random choice (motion sway, slip, sensor noise).
   std::uint32_t seed = 1;
   /// Frame rate of the timestamps, Hz.
@@ -116,7 +120,7 @@ class SequenceRenderer {
   SequenceRenderer& operator=(const SequenceRenderer&) = delete;
 
   /// Frames in the chosen range.
-  int frame_count() const { return last_ - options_.first_frame + 1; }
+  int frame_count() const { return (last_ - options_.first_frame) / options_.frame_step + 1; }
   /// Renders frame i of the range (0-based; frame.index = i).
   RenderedFrame Render(int i);
 
