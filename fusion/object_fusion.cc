@@ -141,7 +141,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
         2 * options_.icp.max_distance_mm * intrinsics_.fx / std::max(1.0, pose.translation().z())));
     const std::array<int, 4> roi = {box[0] - margin, box[1] - margin, box[2] + margin,
                                     box[3] + margin};
-    // The contacts, where the registration moved them, hold ICP where the surface cannot.
+    // The contacts, where the registration moved them, hold ICP where the surface cannot: only
+    // a grasp's (spread like the registration asks), not one fingertip's patch.
     std::vector<IcpAnchor> anchors;
     if (result.pairwise.ok && options_.pairwise.contact_weight > 0 &&
         result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm) {

@@ -45,7 +45,8 @@ struct Contacts {
   /// End-effector bones in contact, and all their vertices (the contact vertices).
   std::vector<int> bones;
   std::vector<int> vertices;
-  /// The threshold at which they were found, mm (the last one tried when none were).
+  /// The threshold at which they were found, mm (the first one, `start_mm`, when the growth
+  /// found no grasp).
   double threshold_mm = 0;
 };
 
