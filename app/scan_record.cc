@@ -78,12 +78,15 @@ void ScanRecord::Add(const FramePacket& packet) {
     entry["contact_noise_mm"] = fused.contact_noise_mm;
     entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;
     entry["contacts_rejected"] = fused.pairwise.contacts_rejected;
+    entry["visual_turn_deg"] = fused.pairwise.visual_turn_deg;
+    entry["visual_turn_kept"] = fused.pairwise.visual_turn_kept;
     if (fused.pairwise.ok) {
       // The correspondences' motion before ICP: tx ty tz qx qy qz qw (mm), for diagnosis.
       const Eigen::Quaterniond q = fused.pairwise.current_from_previous.quaternion();
       const Eigen::Vector3d t = fused.pairwise.current_from_previous.translation();
       entry["pairwise_motion"] = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
       entry["pairwise_rms_mm"] = fused.pairwise.rms_mm;
+      entry["visual_inliers"] = fused.pairwise.visual_inliers;
     }
     if (fused.icp_from_previous) entry["icp_from_previous"] = true;
     if (fused.icp.iterations > 0) {

@@ -162,6 +162,9 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "contact pairs needed when they are all there is");
   r.Add("fusion.pairwise.min_contact_spread_mm", &u.pairwise.min_contact_spread_mm,
         "contacts count only when spread at least this far (two fingertips), mm");
+  r.Add("fusion.pairwise.visual_turn_prior_deg", &u.pairwise.visual_turn_prior_deg,
+        "visual matches alone: their turn shrinks toward none under this prior per frame, "
+        "degrees (0: kept)");
   r.Add("fusion.pairwise.seed", &u.pairwise.seed, "seed of the RANSAC sampling");
   r.Add("fusion.icp.iterations", &u.icp.iterations, "ICP Gauss-Newton iterations at most");
   r.Add("fusion.icp.max_distance_mm", &u.icp.max_distance_mm,

@@ -1,6 +1,7 @@
 #include "fusion/pairwise_registration.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -20,6 +21,7 @@ void PairwiseOptions::Check() const {
   IHS_CHECK_ARG(min_visual_inliers >= 3, "pairwise.min_visual_inliers must be >= 3");
   IHS_CHECK_ARG(min_contacts >= 3, "pairwise.min_contacts must be >= 3");
   IHS_CHECK_ARG(min_contact_spread_mm >= 0, "pairwise.min_contact_spread_mm must be >= 0");
+  IHS_CHECK_ARG(visual_turn_prior_deg >= 0, "pairwise.visual_turn_prior_deg must be >= 0");
 }
 
 namespace {
@@ -87,6 +89,34 @@ double Spread(const std::vector<PointMatch>& contacts) {
                .maxCoeff()));
 }
 
+// How well `matches` fix a rigid motion's turn: the information matrix of its rotation vector
+// (rad⁻²). The residuals after the fit give the points' noise (at least 0.5 mm: a few matches
+// may fit by chance); their scatter about the centroid gives each axis a's information,
+// Σ|q × a|² over the centred points q, divided by the noise's variance.
+Eigen::Matrix3d TurnInformation(const std::vector<PointMatch>& matches) {
+  const size_t n = matches.size();
+  if (n < 3) return Eigen::Matrix3d::Zero();
+  std::vector<Eigen::Vector3d> from, to;
+  for (const PointMatch& m : matches) from.push_back(m.previous), to.push_back(m.current);
+  const Rigid3 motion = FitRigidTransform(from, to);
+  double residual_sq = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    residual_sq += (motion * from[i] - to[i]).squaredNorm();
+    mean += from[i];
+  }
+  mean /= static_cast<double>(n);
+  // Three coordinates per pair, six of them spent on the motion.
+  const double noise_sq =
+      std::max(0.25, residual_sq / std::max<double>(1.0, 3.0 * static_cast<double>(n) - 6.0));
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : from) {
+    const Eigen::Vector3d q = p - mean;
+    information += q.squaredNorm() * Eigen::Matrix3d::Identity() - q * q.transpose();
+  }
+  return information / noise_sq;
+}
+
 }  // namespace
 
 PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& options) {
@@ -118,6 +148,16 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
   const bool use_contacts = options.contact_weight > 0 && spread >= options.min_contact_spread_mm &&
                             (static_cast<int>(contacts.size()) >= options.min_contacts ||
                              (!visual.empty() && !contacts.empty()));
+  Eigen::Matrix3d turn_information = Eigen::Matrix3d::Zero();
+  if (!visual.empty()) {
+    turn_information = TurnInformation(visual);
+    const double weakest =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(turn_information, Eigen::EigenvaluesOnly)
+            .eigenvalues()
+            .minCoeff();
+    result.visual_turn_deg =
+        weakest > 0 ? std::min(180.0, 180.0 / M_PI / std::sqrt(weakest)) : 180.0;
+  }
   if (visual.empty() && !use_contacts) {
     result.reason = "too few correspondences: " + std::to_string(input.features_2d.size()) +
                     " 2D and " + std::to_string(input.features_3d.size()) +
@@ -142,6 +182,26 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     }
   }
   result.current_from_previous = FitRigidTransform(from, to, weights);
+  if (!use_contacts && options.visual_turn_prior_deg > 0) {
+    // Visual pairs alone: their turn, shrunk toward none where they fix it poorly (the
+    // posterior mean of the rotation vector under a zero-mean prior of `visual_turn_prior_deg`
+    // per frame and each axis), about their centroid, which stays where the fit puts it.
+    const double prior = options.visual_turn_prior_deg * M_PI / 180.0;
+    const Eigen::Matrix3d keep = (turn_information + Eigen::Matrix3d::Identity() / (prior * prior))
+                                     .ldlt()
+                                     .solve(turn_information);
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& p : from) centroid += p;
+    centroid /= static_cast<double>(from.size());
+    const Rigid3& fitted = result.current_from_previous;
+    const Eigen::AngleAxisd turn(fitted.rotation());
+    const Eigen::Vector3d fitted_turn = turn.angle() * turn.axis();
+    const Eigen::Vector3d kept_turn = keep * fitted_turn;
+    const Rigid3 shrunk = Rigid3::FromRotationVector(kept_turn, Eigen::Vector3d::Zero());
+    result.current_from_previous =
+        Rigid3(shrunk.rotation(), fitted * centroid - shrunk.rotation() * centroid);
+    result.visual_turn_kept = fitted_turn.norm() > 0 ? kept_turn.norm() / fitted_turn.norm() : 1.0;
+  }
   double sum = 0;
   for (size_t i = 0; i < from.size(); ++i)
     sum += (result.current_from_previous * from[i] - to[i]).squaredNorm();

@@ -48,6 +48,13 @@ struct PairwiseOptions {
   /// them are dropped (a mistracked fingertip; γt times hundreds of contact vertices would
   /// outweigh every feature match).
   bool check_contacts = true;
+  /// A motion from the visual pairs alone (no grasp's contacts) keeps its turn in proportion to
+  /// how well they fix it: shrunk toward none as the posterior mean under a zero-mean prior of
+  /// this standard deviation per frame, degrees, given the pairs' own uncertainty
+  /// (PairwiseResult::visual_turn_deg). A handful of matches on one small patch of a bottle's
+  /// label turned the scan by 3-16° in frames where the truth turned by 0-2°, and ICP cannot
+  /// undo a turn the surface leaves free (the bottle's spin). 0 keeps every turn as fitted.
+  double visual_turn_prior_deg = 1.0;
   /// Seed of the RANSAC sampling (results are deterministic).
   std::uint32_t seed = 1;
 
@@ -69,6 +76,11 @@ struct PairwiseResult {
   int contacts_rejected = 0;
   /// The contacts' spread (see PairwiseOptions::min_contact_spread_mm), mm.
   double contact_spread_mm = 0;
+  /// The visual inliers' uncertainty of the turn about its worst-fixed axis (one standard
+  /// deviation, degrees; 0 without visual inliers). See PairwiseOptions::max_visual_turn_deg.
+  double visual_turn_deg = 0;
+  /// The share of the visual pairs' turn kept (1 where contacts took part or no prior is set).
+  double visual_turn_kept = 1.0;
   /// Root mean square distance of the used pairs after the solve, mm.
   double rms_mm = 0;
 };

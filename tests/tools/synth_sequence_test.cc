@@ -14,6 +14,7 @@
 #include "tests/test_util.h"
 #include "tools/synth/object_shape.h"
 #include "tools/synth/sequence.h"
+#include "tracker/hand_data.h"
 #include "tracker/hand_joints_io.h"
 
 namespace ihs::synth {
@@ -135,9 +136,23 @@ TEST(SynthSequenceTest, IdealSequenceAgreesWithItsGroundTruth) {
   EXPECT_EQ(manifest["object"]["name"], "sphere");
   EXPECT_EQ(manifest["frames"]["count"], 24);
   EXPECT_EQ(manifest["sensor"]["depth_noise"], false);
+  EXPECT_EQ(manifest["hand"], "procedural");
   EXPECT_TRUE(fs::exists(dir / "gt" / "object.ply"));
   EXPECT_TRUE(fs::exists(dir / "gt" / "intrinsics.json"));
   EXPECT_GT(fs::file_size(dir / "contact_sheet.png"), 10000u);
+}
+
+TEST(SynthSequenceTest, ARecordedMotionRendersTheDatasScannedHandAndSaysSo) {
+  if (test::HandDataDir().empty()) GTEST_SKIP() << "../shared/data is absent";
+  SequenceOptions options;
+  options.object = "sphere";
+  options.motion = "recorded:" + (test::HandDataDir() / "sequences" / "004-sphere").string();
+  options.last_frame = 44;  // Enough for the sphere's placement between thumb and index.
+  const SequenceRenderer renderer(options);
+  // The manifest's "hand" is the renderer's source: the data folder, not the default template.
+  EXPECT_EQ(fs::path(renderer.hand_source()), test::HandDataDir());
+  const tracker::HandModel procedural = tracker::LoadHandTemplate("procedural", true);
+  EXPECT_NE(renderer.hand().rest_mesh.vertices.size(), procedural.rest_mesh.vertices.size());
 }
 
 TEST(SynthSequenceTest, OpenNiPlaysTheRecording) {

@@ -106,8 +106,10 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     recorded_options.last_frame = options_.last_frame;
     motion_ = MakeRecordedMotion(recording, object_, recorded_options, &recorded_report_);
     hand_ = std::move(recording.model);
+    hand_source_ = data_dir.string();
   } else {
     hand_ = tracker::LoadHandTemplate(options_.hand, !options_.left_hand);
+    hand_source_ = options_.hand;
     if (options_.hand_scale != 1.0) hand_ = hand_.Scaled(options_.hand_scale);
     motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }
@@ -281,7 +283,7 @@ SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path&
         {"textured", object.textured()},
         {"volume_mm3", object.mesh().Volume()}}},
       {"motion", options.motion},
-      {"hand", options.hand},
+      {"hand", renderer.hand_source()},
       {"hand_scale", options.hand_scale},
       {"hand_bones", bone_names.size()},
       {"frames",

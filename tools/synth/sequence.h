@@ -126,6 +126,9 @@ class SequenceRenderer {
 
   const SequenceOptions& options() const { return options_; }
   const tracker::HandModel& hand() const { return hand_; }
+  /// Where the rendered hand came from: "procedural" or a hand data folder (a recorded motion
+  /// brings the data's scanned hand).
+  const std::string& hand_source() const { return hand_source_; }
   const ObjectShape& object() const { return object_; }
   /// The object's mesh as rendered (with its colours).
   const TriangleMesh& object_mesh() const { return object_mesh_; }
@@ -139,6 +142,7 @@ class SequenceRenderer {
   tracker::HandModel hand_;
   Motion motion_;
   RecordedMotionReport recorded_report_;
+  std::string hand_source_;
   int last_ = 0;
   std::unique_ptr<HandObjectGeometry> geometry_;
   std::unique_ptr<render::OffscreenRenderer> renderer_;
