@@ -77,7 +77,7 @@ struct PairwiseResult {
   /// The contacts' spread (see PairwiseOptions::min_contact_spread_mm), mm.
   double contact_spread_mm = 0;
   /// The visual inliers' uncertainty of the turn about its worst-fixed axis (one standard
-  /// deviation, degrees; 0 without visual inliers). See PairwiseOptions::max_visual_turn_deg.
+  /// deviation, degrees; 0 without visual inliers). See PairwiseOptions::visual_turn_prior_deg.
   double visual_turn_deg = 0;
   /// The share of the visual pairs' turn kept (1 where contacts took part or no prior is set).
   double visual_turn_kept = 1.0;
