@@ -89,32 +89,38 @@ double Spread(const std::vector<PointMatch>& contacts) {
                .maxCoeff()));
 }
 
-// How well `matches` fix a rigid motion's turn: the information matrix of its rotation vector
-// (rad⁻²). The residuals after the fit give the points' noise (at least 0.5 mm: a few matches
-// may fit by chance); their scatter about the centroid gives each axis a's information,
-// Σ|q × a|² over the centred points q, divided by the noise's variance.
-Eigen::Matrix3d TurnInformation(const std::vector<PointMatch>& matches) {
+// The visual inliers' own motion, their centroid (previous frame) and how well they fix the
+// motion's turn: the information matrix of its rotation vector (rad⁻²). The residuals after the
+// fit give the points' noise (at least 0.5 mm: a few matches may fit by chance); their scatter
+// about the centroid gives each axis a's information, Σ|q × a|² over the centred points q,
+// divided by the noise's variance.
+struct VisualFit {
+  Rigid3 motion;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d turn_information = Eigen::Matrix3d::Zero();
+};
+
+VisualFit FitVisual(const std::vector<PointMatch>& matches) {
+  VisualFit fit;
   const size_t n = matches.size();
-  if (n < 3) return Eigen::Matrix3d::Zero();
   std::vector<Eigen::Vector3d> from, to;
   for (const PointMatch& m : matches) from.push_back(m.previous), to.push_back(m.current);
-  const Rigid3 motion = FitRigidTransform(from, to);
+  fit.motion = FitRigidTransform(from, to);
   double residual_sq = 0;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < n; ++i) {
-    residual_sq += (motion * from[i] - to[i]).squaredNorm();
-    mean += from[i];
+    residual_sq += (fit.motion * from[i] - to[i]).squaredNorm();
+    fit.centroid += from[i];
   }
-  mean /= static_cast<double>(n);
+  fit.centroid /= static_cast<double>(n);
   // Three coordinates per pair, six of them spent on the motion.
   const double noise_sq =
       std::max(0.25, residual_sq / std::max<double>(1.0, 3.0 * static_cast<double>(n) - 6.0));
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
   for (const Eigen::Vector3d& p : from) {
-    const Eigen::Vector3d q = p - mean;
-    information += q.squaredNorm() * Eigen::Matrix3d::Identity() - q * q.transpose();
+    const Eigen::Vector3d q = p - fit.centroid;
+    fit.turn_information += q.squaredNorm() * Eigen::Matrix3d::Identity() - q * q.transpose();
   }
-  return information / noise_sq;
+  fit.turn_information /= noise_sq;
+  return fit;
 }
 
 }  // namespace
@@ -128,16 +134,25 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     visual.insert(visual.end(), input.features_3d.begin(), input.features_3d.end());
     visual = RansacInliers(visual, options);
   }
+  // RansacInliers returns a set of at least min_visual_inliers (>= 3) pairs, or none.
+  VisualFit visual_fit;
+  if (!visual.empty()) {
+    visual_fit = FitVisual(visual);
+    const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(
+                               visual_fit.turn_information, Eigen::EigenvaluesOnly)
+                               .eigenvalues()
+                               .minCoeff();
+    result.visual_turn_deg =
+        weakest > 0 ? std::min(180.0, 180.0 / M_PI / std::sqrt(weakest)) : 180.0;
+  }
   // Contacts that a consistent visual set contradicts are a mistracked hand's, not the object's:
   // each counts γt times, and hundreds of them would outweigh every good feature match.
   std::vector<PointMatch> contacts;
   if (options.check_contacts && !visual.empty() && options.contact_weight > 0) {
-    std::vector<Eigen::Vector3d> from, to;
-    for (const PointMatch& m : visual) from.push_back(m.previous), to.push_back(m.current);
-    const Rigid3 seen = FitRigidTransform(from, to);
     const double inlier_sq = options.inlier_mm * options.inlier_mm;
     for (const PointMatch& m : input.contacts) {
-      if ((seen * m.previous - m.current).squaredNorm() < inlier_sq) contacts.push_back(m);
+      if ((visual_fit.motion * m.previous - m.current).squaredNorm() < inlier_sq)
+        contacts.push_back(m);
     }
     result.contacts_rejected = static_cast<int>(input.contacts.size() - contacts.size());
   } else {
@@ -148,16 +163,6 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
   const bool use_contacts = options.contact_weight > 0 && spread >= options.min_contact_spread_mm &&
                             (static_cast<int>(contacts.size()) >= options.min_contacts ||
                              (!visual.empty() && !contacts.empty()));
-  Eigen::Matrix3d turn_information = Eigen::Matrix3d::Zero();
-  if (!visual.empty()) {
-    turn_information = TurnInformation(visual);
-    const double weakest =
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(turn_information, Eigen::EigenvaluesOnly)
-            .eigenvalues()
-            .minCoeff();
-    result.visual_turn_deg =
-        weakest > 0 ? std::min(180.0, 180.0 / M_PI / std::sqrt(weakest)) : 180.0;
-  }
   if (visual.empty() && !use_contacts) {
     result.reason = "too few correspondences: " + std::to_string(input.features_2d.size()) +
                     " 2D and " + std::to_string(input.features_3d.size()) +
@@ -187,12 +192,11 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     // posterior mean of the rotation vector under a zero-mean prior of `visual_turn_prior_deg`
     // per frame and each axis), about their centroid, which stays where the fit puts it.
     const double prior = options.visual_turn_prior_deg * M_PI / 180.0;
-    const Eigen::Matrix3d keep = (turn_information + Eigen::Matrix3d::Identity() / (prior * prior))
-                                     .ldlt()
-                                     .solve(turn_information);
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& p : from) centroid += p;
-    centroid /= static_cast<double>(from.size());
+    const Eigen::Matrix3d keep =
+        (visual_fit.turn_information + Eigen::Matrix3d::Identity() / (prior * prior))
+            .ldlt()
+            .solve(visual_fit.turn_information);
+    const Eigen::Vector3d& centroid = visual_fit.centroid;
     const Rigid3& fitted = result.current_from_previous;
     const Eigen::AngleAxisd turn(fitted.rotation());
     const Eigen::Vector3d fitted_turn = turn.angle() * turn.axis();
