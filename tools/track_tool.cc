@@ -12,7 +12,9 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
+#include "app/scanner_options.h"
 #include "core/allocator.h"
 #include "core/atomic_file.h"
 #include "core/command_line.h"
@@ -38,11 +40,22 @@ double Quantile(std::vector<double> values, double q) {
 }
 
 // hand_scale: the template's scale, or 0 to estimate it over the first frames.
+// assignments: `tracker.NAME=VALUE` settings of inhandscan's options (`inhandscan config`).
 int Run(const std::string& input, const fs::path& out, const std::string& gt_dir, bool init_from_gt,
-        const std::string& template_name, double hand_scale, bool left_hand) {
+        const std::string& template_name, double hand_scale, bool left_hand,
+        const std::vector<std::string>& assignments) {
   HandModel model = ihs::tracker::LoadHandTemplate(template_name, !left_hand);
+  ihs::app::ScannerOptions scanner;
+  ihs::app::OptionRegistry registry = ihs::app::RegisterScannerOptions(&scanner);
+  for (const std::string& assignment : assignments) {
+    if (assignment.rfind("tracker.", 0) != 0) {
+      throw std::invalid_argument("--set " + assignment +
+                                  ": inhandscan-track takes only tracker.* options");
+    }
+    registry.SetAssignment(assignment);
+  }
+  ihs::tracker::TrackerOptions options = scanner.tracker;
   // The procedural template's size is estimated unless given; a scanned hand has its owner's.
-  ihs::tracker::TrackerOptions options;
   if (hand_scale > 0) model = model.Scaled(hand_scale);
   if (hand_scale > 0 || template_name != "procedural") options.scale_frames = 0;
   // Ground truth: joints per frame and the object's trajectory.
@@ -113,9 +126,12 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
     if (index > 0 && index < static_cast<std::int64_t>(gt_trajectory.size())) {
       const ihs::Rigid3 motion =
           gt_trajectory[index].transform * gt_trajectory[index - 1].transform.Inverse();
+      std::vector<double> errors;
       for (const auto& pair : result.contact_pairs) {
-        contact_errors.push_back((motion * pair.previous_mm - pair.current_mm).norm());
+        errors.push_back((motion * pair.previous_mm - pair.current_mm).norm());
       }
+      if (!errors.empty()) entry["contact_error_mm"] = Quantile(errors, 0.5);
+      contact_errors.insert(contact_errors.end(), errors.begin(), errors.end());
     }
     frames.push_back(entry);
     ++index;
@@ -197,11 +213,15 @@ int main(int argc, char** argv) {
   app.add_flag("--left-hand", left_hand,
                "the hand is a left one (the procedural template is mirrored; a scanned one must "
                "be a left hand)");
+  std::vector<std::string> assignments;
+  app.add_option("--set", assignments,
+                 "set one of the tracker's options: tracker.NAME=VALUE (repeatable; `inhandscan "
+                 "config` lists them)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
   app.add_flag("-q,--quiet", quiet, "only warnings and errors");
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-track", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
-    return Run(input, out, gt, init_from_gt, template_name, hand_scale, left_hand);
+    return Run(input, out, gt, init_from_gt, template_name, hand_scale, left_hand, assignments);
   });
 }

@@ -37,6 +37,22 @@ TEST(TrackToolTest, TracksAGeneratedSequenceAndMeasuresItsErrors) {
   EXPECT_LT(stats["summary"]["joint_error_mm_mean"].get<double>(), 15.0);
   EXPECT_NE(test::ReadFileString(dir / "out" / "contacts.csv").find("frame,status"),
             std::string::npos);
+  // Each frame with contact pairs gives their median error; the summary pools them.
+  int frames_with_contact_error = 0;
+  for (const auto& frame : stats["frames"])
+    frames_with_contact_error += frame.contains("contact_error_mm");
+  EXPECT_EQ(frames_with_contact_error > 0, stats["summary"].contains("contact_error_mm_median"));
+
+  // --set reaches the tracker: with a hand needing more points than a frame has, none is found.
+  const auto strict =
+      RunTool((dir / "seq" / "sequence.oni").string() + " --out " + (dir / "strict").string() +
+              " --set tracker.min_hand_points=1000000 -q");
+  ASSERT_EQ(strict.exit_code, 0) << strict.err;
+  const auto strict_stats =
+      nlohmann::json::parse(test::ReadFileString(dir / "strict" / "stats.json"));
+  EXPECT_EQ(strict_stats["summary"]["status_counts"].size(), 1u) << strict_stats["summary"];
+  EXPECT_EQ(strict_stats["summary"]["status_counts"].value("no_hand", 0), 12)
+      << strict_stats["summary"];
 }
 
 TEST(TrackToolTest, BadInputAndOptionsGetOneLineErrors) {
@@ -49,6 +65,13 @@ TEST(TrackToolTest, BadInputAndOptionsGetOneLineErrors) {
   EXPECT_EQ(no_gt.exit_code, 2) << no_gt.err;
   const auto bad_scale = RunTool("x.oni --hand-scale 9 --out " + (dir / "o").string());
   EXPECT_EQ(bad_scale.exit_code, 2);
+  // --set takes the tracker's options only, each by a known name and a value of its type.
+  for (const std::string& assignment :
+       {"fusion.icp.anchor_share=1", "tracker.no_such_option=1", "tracker.fit.prior_weight=abc"}) {
+    const auto bad_set = RunTool("x.oni --set " + assignment + " --out " + (dir / "o").string());
+    EXPECT_EQ(bad_set.exit_code, 2) << assignment << ": " << bad_set.err;
+    EXPECT_EQ(std::count(bad_set.err.begin(), bad_set.err.end(), '\n'), 1) << bad_set.err;
+  }
 }
 
 }  // namespace
