@@ -78,6 +78,8 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "object pixels this close to the hand are left out");
   r.Add("tracker.segmentation.max_object_distance_mm", &s.max_object_distance_mm,
         "object regions farther than this from the hand's centre are left out, mm");
+  r.Add("tracker.segmentation.object_margin_mm", &s.object_margin_mm,
+        "an object region reaching into the crop volume goes on this far beyond it, mm");
   tracker::HandFitOptions& f = t.fit;
   r.Add("tracker.fit.collision_weight", &f.collision_weight,
         "gamma_c, weight of the finger collision term (paper: 10)");

@@ -58,6 +58,7 @@ void SegmentationOptions::Check() const {
   IHS_CHECK_ARG(boundary_px >= 0 && boundary_px <= 20,
                 "segmentation.boundary_px must be in [0, 20]");
   IHS_CHECK_ARG(max_object_distance_mm > 0, "segmentation.max_object_distance_mm must be positive");
+  IHS_CHECK_ARG(object_margin_mm >= 0, "segmentation.object_margin_mm must be >= 0");
 }
 
 Segmenter::Segmenter(const CameraIntrinsics& intrinsics, SegmentationOptions options)
@@ -83,18 +84,21 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
   out.hand_mask.assign(n, 0);
   out.object_mask.assign(n, 0);
 
-  // The box around the pixels inside the crop volume; everything after works in it.
-  auto in_crop = [&](int u, int v, std::uint16_t z) {
-    if (z == 0 || z < options_.crop_min_mm.z() || z > options_.crop_max_mm.z()) return false;
+  // The box around the pixels inside the crop volume grown by the object's margin; everything
+  // after works in it.
+  auto in_crop = [&](int u, int v, std::uint16_t z, double margin) {
+    if (z == 0 || z < options_.crop_min_mm.z() - margin || z > options_.crop_max_mm.z() + margin)
+      return false;
     const Eigen::Vector3d x = intrinsics_.BackProject(u, v, z);
-    return (x.array() >= options_.crop_min_mm.array()).all() &&
-           (x.array() <= options_.crop_max_mm.array()).all();
+    return (x.array() >= options_.crop_min_mm.array() - margin).all() &&
+           (x.array() <= options_.crop_max_mm.array() + margin).all();
   };
+  const double margin = options_.object_margin_mm;
   int u0 = w, v0 = h, u1 = 0, v1 = 0;
   for (int v = 0; v < h; ++v) {
     const std::uint16_t* row = &frame.depth_mm[static_cast<size_t>(v) * w];
     for (int u = 0; u < w; ++u) {
-      if (!in_crop(u, v, row[u])) continue;
+      if (!in_crop(u, v, row[u], margin)) continue;
       u0 = std::min(u0, u), v0 = std::min(v0, v), u1 = std::max(u1, u + 1), v1 = v + 1;
     }
   }
@@ -112,17 +116,20 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
                                    depth[i]);
   };
 
-  // Classify cropped pixels by colour.
+  // Classify pixels by colour: skin only inside the crop volume, anything else within the margin.
   std::vector<std::uint8_t> classes(bn, kNone);
+  std::vector<std::uint8_t> inside(bn, 0);
   for (size_t i = 0; i < bn; ++i) {
-    if (!in_crop(static_cast<int>(i % bw) + u0, static_cast<int>(i / bw) + v0, depth[i])) continue;
-    ++out.cropped_pixels;
+    const int u = static_cast<int>(i % bw) + u0, v = static_cast<int>(i / bw) + v0;
+    if (!in_crop(u, v, depth[i], margin)) continue;
+    inside[i] = margin == 0 || in_crop(u, v, depth[i], 0.0);
+    out.cropped_pixels += inside[i];
     bool skin = false;
     if (frame.HasColor()) {
       const std::uint8_t* c = &frame.rgb[3 * image_index(i)];
       skin = skin_->LogLikelihoodRatio(c[0], c[1], c[2]) > options_.skin_log_ratio;
     }
-    classes[i] = skin ? kSkin : kOther;
+    classes[i] = skin ? (inside[i] ? kSkin : kNone) : kOther;
   }
 
   // Depth-connected regions; small ones go.
@@ -151,9 +158,13 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
       }
     }
   }
+  // Each object region's part inside the crop volume: its centre and size.
   std::vector<Eigen::Vector3d> region_sum(sizes.size(), Eigen::Vector3d::Zero());
+  std::vector<int> inside_sizes(sizes.size(), 0);
   for (size_t i = 0; i < bn; ++i) {
-    if (classes[i] == kOther) region_sum[region[i]] += point(i);
+    if (classes[i] != kOther || !inside[i]) continue;
+    region_sum[region[i]] += point(i);
+    ++inside_sizes[region[i]];
   }
   const Eigen::Vector3d hand_centre =
       hand_count > 0 ? Eigen::Vector3d(hand_sum / hand_count) : Eigen::Vector3d::Zero();
@@ -165,9 +176,9 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
     }
     if (classes[i] != kOther || near_hand[i]) continue;
     const int id = region[i];
-    if (sizes[id] < options_.min_region_pixels) continue;
-    if (hand_count > 0 &&
-        (region_sum[id] / sizes[id] - hand_centre).norm() > options_.max_object_distance_mm) {
+    if (sizes[id] < options_.min_region_pixels || inside_sizes[id] == 0) continue;
+    if (hand_count > 0 && (region_sum[id] / inside_sizes[id] - hand_centre).norm() >
+                              options_.max_object_distance_mm) {
       continue;
     }
     out.object_mask[image_index(i)] = 1;

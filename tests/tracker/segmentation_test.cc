@@ -44,9 +44,10 @@ struct MaskScore {
   double precision = 0, recall = 0;
 };
 
-// Precision and recall of `mask` against pixels labelled `label` that have depth in the crop.
+// Precision and recall of `mask` against pixels labelled `label` that have depth in the crop
+// volume, grown by `margin_mm`.
 MaskScore Score(const std::vector<std::uint8_t>& mask, const synth::RenderedFrame& rendered,
-                std::uint8_t label) {
+                std::uint8_t label, double margin_mm) {
   const CameraIntrinsics intrinsics;
   const SegmentationOptions options;
   long true_positive = 0, predicted = 0, actual = 0;
@@ -54,8 +55,8 @@ MaskScore Score(const std::vector<std::uint8_t>& mask, const synth::RenderedFram
     const std::uint16_t z = rendered.frame.depth_mm[p];
     if (z == 0) continue;
     const Eigen::Vector3d x = intrinsics.BackProject(p % 640, p / 640, z);
-    const bool in_crop = (x.array() >= options.crop_min_mm.array()).all() &&
-                         (x.array() <= options.crop_max_mm.array()).all();
+    const bool in_crop = (x.array() >= options.crop_min_mm.array() - margin_mm).all() &&
+                         (x.array() <= options.crop_max_mm.array() + margin_mm).all();
     const bool is = rendered.labels[p] == label && in_crop;
     predicted += mask[p];
     actual += is;
@@ -73,8 +74,9 @@ void ExpectGoodMasks(synth::SequenceOptions options, const char* name) {
   for (int i = 0; i < renderer.frame_count(); i += std::max(1, renderer.frame_count() / 6)) {
     const synth::RenderedFrame rendered = renderer.Render(i);
     const Segmentation s = segmenter.Segment(rendered.frame);
-    const MaskScore hand = Score(s.hand_mask, rendered, render::kHand);
-    const MaskScore object = Score(s.object_mask, rendered, render::kObject);
+    const MaskScore hand = Score(s.hand_mask, rendered, render::kHand, 0.0);
+    const MaskScore object =
+        Score(s.object_mask, rendered, render::kObject, SegmentationOptions().object_margin_mm);
     std::printf("%s frame %d: hand precision %.3f recall %.3f, object precision %.3f recall %.3f\n",
                 name, i, hand.precision, hand.recall, object.precision, object.recall);
     hand_total.precision += hand.precision, hand_total.recall += hand.recall;
@@ -121,6 +123,41 @@ TEST(SegmentationTest, WithoutColourEverythingIsObjectAndTheCropHolds) {
   EXPECT_EQ(s.cropped_pixels, 80 * 80);
   const Segmentation empty = segmenter.Segment(Frame::Blank(640, 480, true));
   EXPECT_TRUE(empty.hand_points.empty() && empty.object_points.empty());
+}
+
+TEST(SegmentationTest, AnObjectReachingIntoTheCropGoesOnBeyondItUpToTheMargin) {
+  // A bar at 600 mm from x = 37 mm to the image's right edge (x = 365 mm), rows 200–279, and a
+  // block wholly outside the crop and its margin (x < −250 mm).
+  Frame frame = Frame::Blank(640, 480, false);
+  for (int v = 200; v < 280; ++v) {
+    for (int u = 352; u < 640; ++u) frame.depth_mm[v * 640 + u] = 600;
+    for (int u = 0; u < 40; ++u) frame.depth_mm[v * 640 + u] = 600;
+  }
+  const CameraIntrinsics intrinsics;
+  // The bar's columns within x ≤ 100 mm (the crop) and x ≤ 250 mm (crop and margin).
+  size_t in_crop = 0, in_margin = 0;
+  for (int u = 352; u < 640; ++u) {
+    const double x = intrinsics.BackProject(u, 240, 600).x();
+    in_crop += x <= 100.0, in_margin += x <= 250.0;
+  }
+  ASSERT_GT(in_crop, 50u);
+  ASSERT_GT(in_margin, in_crop + 100);
+  ASSERT_LT(in_margin, 640u - 352u);
+
+  const Segmentation s = Segmenter(intrinsics).Segment(frame);
+  EXPECT_EQ(s.cropped_pixels, static_cast<int>(80 * in_crop));
+  EXPECT_EQ(s.object_points.size(), 80 * in_margin);
+  float x_max = -1e9f;
+  for (const Eigen::Vector3f& p : s.object_points) x_max = std::max(x_max, p.x());
+  EXPECT_GT(x_max, 245.0f);
+  EXPECT_LE(x_max, 250.0f);
+
+  // Without a margin the object is cropped like the hand.
+  SegmentationOptions tight;
+  tight.object_margin_mm = 0;
+  const Segmentation cropped = Segmenter(intrinsics, tight).Segment(frame);
+  EXPECT_EQ(cropped.object_points.size(), 80 * in_crop);
+  EXPECT_EQ(cropped.cropped_pixels, s.cropped_pixels);
 }
 
 }  // namespace
