@@ -84,21 +84,22 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
   out.hand_mask.assign(n, 0);
   out.object_mask.assign(n, 0);
 
-  // The box around the pixels inside the crop volume grown by the object's margin; everything
-  // after works in it.
-  auto in_crop = [&](int u, int v, std::uint16_t z, double margin) {
-    if (z == 0 || z < options_.crop_min_mm.z() - margin || z > options_.crop_max_mm.z() + margin)
-      return false;
-    const Eigen::Vector3d x = intrinsics_.BackProject(u, v, z);
-    return (x.array() >= options_.crop_min_mm.array() - margin).all() &&
-           (x.array() <= options_.crop_max_mm.array() + margin).all();
-  };
+  // Where a pixel lies: 0 outside the crop volume grown by the object's margin, 1 in the margin
+  // only, 2 inside the volume. Everything after works in the box around the grown volume's pixels.
   const double margin = options_.object_margin_mm;
+  auto crop_level = [&](int u, int v, std::uint16_t z) {
+    if (z == 0 || z < options_.crop_min_mm.z() - margin || z > options_.crop_max_mm.z() + margin)
+      return 0;
+    const Eigen::Array3d x = intrinsics_.BackProject(u, v, z).array();
+    const Eigen::Array3d low = options_.crop_min_mm.array(), high = options_.crop_max_mm.array();
+    if ((x < low - margin).any() || (x > high + margin).any()) return 0;
+    return (x >= low).all() && (x <= high).all() ? 2 : 1;
+  };
   int u0 = w, v0 = h, u1 = 0, v1 = 0;
   for (int v = 0; v < h; ++v) {
     const std::uint16_t* row = &frame.depth_mm[static_cast<size_t>(v) * w];
     for (int u = 0; u < w; ++u) {
-      if (!in_crop(u, v, row[u], margin)) continue;
+      if (crop_level(u, v, row[u]) == 0) continue;
       u0 = std::min(u0, u), v0 = std::min(v0, v), u1 = std::max(u1, u + 1), v1 = v + 1;
     }
   }
@@ -120,9 +121,10 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
   std::vector<std::uint8_t> classes(bn, kNone);
   std::vector<std::uint8_t> inside(bn, 0);
   for (size_t i = 0; i < bn; ++i) {
-    const int u = static_cast<int>(i % bw) + u0, v = static_cast<int>(i / bw) + v0;
-    if (!in_crop(u, v, depth[i], margin)) continue;
-    inside[i] = margin == 0 || in_crop(u, v, depth[i], 0.0);
+    const int level =
+        crop_level(static_cast<int>(i % bw) + u0, static_cast<int>(i / bw) + v0, depth[i]);
+    if (level == 0) continue;
+    inside[i] = level == 2;
     out.cropped_pixels += inside[i];
     bool skin = false;
     if (frame.HasColor()) {
