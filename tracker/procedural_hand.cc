@@ -27,6 +27,12 @@ Rigid3 BoneFrame(const Eigen::Vector3d& start, const Eigen::Vector3d& direction,
   return Rigid3(rotation, start);
 }
 
+// `frame` moved by `distance` along its own z axis (into the palm, for a BoneFrame).
+Rigid3 Shifted(const Rigid3& frame, double distance) {
+  if (distance == 0) return frame;
+  return Rigid3(frame.rotation(), frame.translation() + distance * frame.rotation().col(2));
+}
+
 // The limits of a right hand's joint, or of the mirrored joint of a left hand: mirroring keeps
 // the flexion axis (BoneFrame) but turns twist and spread the other way round their axes.
 JointLimits Limits(std::array<std::pair<double, double>, 3> ranges_deg, bool right_hand) {
@@ -125,7 +131,14 @@ void AppendCapsule(HandModel& model, const Rigid3& model_from_capsule, double le
 }  // namespace
 
 void ProceduralHandOptions::Check() const {
-  IHS_CHECK_ARG(wrist_length_mm > 0, "hand.wrist_length_mm must be positive");
+  auto norm = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  IHS_CHECK_ARG(norm(wrist_start_mm, {0, 0, 0}) > 1, "hand.wrist_start_mm must not be the wrist");
+  for (int f = 0; f < 5; ++f) {
+    IHS_CHECK_ARG(norm(metacarpal_start_mm[f], metacarpal_end_mm[f]) > 1,
+                  "hand.metacarpal_end_mm must lie away from its metacarpal_start_mm");
+  }
   for (const auto& finger : finger_lengths_mm) {
     for (double length : finger)
       IHS_CHECK_ARG(length > 0, "hand.finger_lengths_mm must be positive");
@@ -143,6 +156,12 @@ void ProceduralHandOptions::Check() const {
   IHS_CHECK_ARG(
       wrist_width_mm > 0 && wrist_thickness_mm > 0 && wrist_thickness_mm <= wrist_width_mm,
       "hand.wrist_width_mm and wrist_thickness_mm must be positive, thickness <= width");
+  IHS_CHECK_ARG(wrist_palmar_offset_mm >= 0 && wrist_palmar_offset_mm < wrist_thickness_mm / 2 &&
+                    palm_palmar_offset_mm >= 0 && palm_palmar_offset_mm < palm_thickness_mm / 2,
+                "hand.wrist_palmar_offset_mm and palm_palmar_offset_mm must be in [0, half the "
+                "thickness)");
+  IHS_CHECK_ARG(finger_palmar_offset >= 0 && finger_palmar_offset < 1,
+                "hand.finger_palmar_offset must be in [0, 1), got " << finger_palmar_offset);
   IHS_CHECK_ARG(segments >= 6 && segments <= 64,
                 "hand.segments must be in [6, 64], got " << segments);
 }
@@ -164,62 +183,78 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   root.limits_deg = {{{-180, 180}, {-180, 180}, {-180, 180}}};
   const bool right = options.right_hand;
   const double palm = right ? -1.0 : 1.0;  // The palm's side along y.
-  const double wrist = options.wrist_length_mm;
-  add_bone("Lower Arm R", -1, wrist, BoneFrame({0, 0, -wrist}, Eigen::Vector3d::UnitZ(), palm),
-           root);
+  // The options' places are a right hand's; a left hand's mirror y.
+  auto place = [&](const std::array<double, 3>& p) {
+    return Eigen::Vector3d(p[0], right ? p[1] : -p[1], p[2]);
+  };
+  const Eigen::Vector3d wrist_start = place(options.wrist_start_mm);
+  add_bone("Lower Arm R", -1, wrist_start.norm(), BoneFrame(wrist_start, -wrist_start, palm), root);
 
-  // Fingers 0..3 (pinky to index): metacarpals fan out from the wrist to the knuckles.
-  const double base_x[4] = {-15, -5, 5, 15}, knuckle_x[4] = {-30, -10, 10, 30};
-  for (int f = 0; f < 4; ++f) {
-    const auto& lengths = options.finger_lengths_mm[f];
-    const std::string prefix = "RFing." + std::to_string(f) + "_";
-    const Eigen::Vector3d start(base_x[f], 0, 0);
-    const Eigen::Vector3d knuckle(knuckle_x[f], 0, lengths[0]);
-    const Eigen::Vector3d direction = (knuckle - start).normalized();
-    Rigid3 frame = BoneFrame(start, direction, palm);
-    int parent = 0;
-    const JointLimits joint_limits[4] = {Limits({{{0, 0}, {-10, 1}, {0, 0}}}, right),
-                                         Limits({{{0, 0}, {-95, 20}, {-30, 15}}}, right),
-                                         Limits({{{0, 0}, {-100, 10}, {0, 0}}}, right),
-                                         Limits({{{0, 0}, {-90, 10}, {0, 0}}}, right)};
-    const char* names[4] = {"Hand", "0", "1", "2"};
-    for (int k = 0; k < 4; ++k) {
-      const double length = (k == 0 ? (knuckle - start).norm() : lengths[k]);
-      parent = add_bone(prefix + names[k], parent, length, frame, joint_limits[k]);
-      frame = frame * Rigid3::Translation({length, 0, 0});  // The child starts at the end.
+  // Fingers 0..3 (pinky to index) and the thumb (4): metacarpals fan out from the wrist to the
+  // knuckles, the phalanges go on in their metacarpal's direction.
+  const JointLimits finger_limits[4] = {
+      Limits({{{0, 0}, {-10, 1}, {0, 0}}}, right), Limits({{{0, 0}, {-95, 20}, {-30, 15}}}, right),
+      Limits({{{0, 0}, {-100, 10}, {0, 0}}}, right), Limits({{{0, 0}, {-90, 10}, {0, 0}}}, right)};
+  const JointLimits thumb_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-40, 30}}}, right),
+                                       Limits({{{0, 0}, {-60, 10}, {-15, 15}}}, right),
+                                       Limits({{{0, 0}, {-90, 10}, {0, 0}}}, right)};
+  const char* names[4] = {"Hand", "0", "1", "2"};
+  for (int f = 0; f < 5; ++f) {
+    const bool thumb = f == 4;
+    const Eigen::Vector3d start = place(options.metacarpal_start_mm[f]);
+    const Eigen::Vector3d knuckle = place(options.metacarpal_end_mm[f]);
+    std::vector<double> lengths = {(knuckle - start).norm()};
+    if (thumb) {
+      lengths.insert(lengths.end(), options.thumb_lengths_mm.begin(),
+                     options.thumb_lengths_mm.end());
+    } else {
+      lengths.insert(lengths.end(), options.finger_lengths_mm[f].begin(),
+                     options.finger_lengths_mm[f].end());
     }
-  }
-  // Thumb: from the side of the wrist, toward +x and forward, turned toward the palm.
-  {
-    const Eigen::Vector3d start(18, 4 * palm, 5);
-    Rigid3 frame = BoneFrame(start, Eigen::Vector3d(0.75, 0.25 * palm, 0.6), palm);
-    const JointLimits joint_limits[3] = {Limits({{{-20, 20}, {-40, 20}, {-40, 30}}}, right),
-                                         Limits({{{0, 0}, {-60, 10}, {-15, 15}}}, right),
-                                         Limits({{{0, 0}, {-90, 10}, {0, 0}}}, right)};
-    const char* names[3] = {"Hand", "0", "1"};
+    Rigid3 frame = BoneFrame(start, knuckle - start, palm);
     int parent = 0;
-    for (int k = 0; k < 3; ++k) {
-      const double length = options.thumb_lengths_mm[k];
-      parent = add_bone(std::string("RFing.4_") + names[k], parent, length, frame, joint_limits[k]);
-      frame = frame * Rigid3::Translation({length, 0, 0});
+    for (size_t k = 0; k < lengths.size(); ++k) {
+      parent = add_bone("RFing." + std::to_string(f) + "_" + names[k], parent, lengths[k], frame,
+                        thumb ? thumb_limits[k] : finger_limits[k]);
+      frame = frame * Rigid3::Translation({lengths[k], 0, 0});  // The child starts at the end.
     }
   }
 
-  // Skin. The palm: one flat capsule from the wrist to the knuckles, each point skinned to
-  // the metacarpals nearest across the palm (and to the wrist near its start).
+  // Skin. The palm: one flat capsule from the metacarpals' starts to the knuckles, as broad as
+  // the knuckles' line is long and turned with it, each point skinned to the metacarpals nearest
+  // across the palm (and to the wrist near its start).
   const int segments = options.segments;
-  const double palm_length = 58, palm_radius = options.palm_base_width_mm / 2;
   std::array<int, 4> metacarpals;
-  for (int f = 0; f < 4; ++f)
+  std::array<Eigen::Vector3d, 4> starts, knuckles;
+  Eigen::Vector3d base = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
+  for (int f = 0; f < 4; ++f) {
     metacarpals[f] = model.BoneIndex("RFing." + std::to_string(f) + "_Hand");
+    starts[f] = place(options.metacarpal_start_mm[f]);
+    knuckles[f] = place(options.metacarpal_end_mm[f]);
+    base += starts[f] / 4;
+    top += knuckles[f] / 4;
+  }
+  const Eigen::Vector3d along = (top - base).normalized();
+  // Across the palm, square to `along`: toward the little finger for a right hand, toward the
+  // index for a left one (as BoneFrame's y).
+  const Eigen::Vector3d knuckle_line = palm * (knuckles[3] - knuckles[0]);
+  const Eigen::Vector3d across = (knuckle_line - knuckle_line.dot(along) * along).normalized();
+  Eigen::Matrix3d palm_rotation;
+  palm_rotation << along, across, along.cross(across);
+  // The capsule's body starts 8 mm up from the metacarpals' starts and ends 7.45 mm short of the
+  // knuckles (its caps reach 12 mm beyond either end).
+  const double palm_start = 8, palm_end_gap = 7.45;
+  const double palm_length = (top - base).norm() - palm_start - palm_end_gap;
+  const double palm_radius = options.palm_base_width_mm / 2;
   const WeightFunction palm_weights = [&](const Eigen::Vector3d& p) {
     VertexWeights weights;
-    const double along = std::clamp(p.z() / (palm_length + 8), 0.0, 1.0);
-    const double to_wrist = 0.5 * std::max(0.0, 1 - p.z() / 20);
+    const double height = (p - base).dot(along);
+    const double to_wrist = 0.5 * std::max(0.0, 1 - height / 20);
+    const double t = std::clamp(height / (palm_length + palm_start), 0.0, 1.0);
     double raw[4], sum = 0;
     for (int f = 0; f < 4; ++f) {
-      const double axis_x = base_x[f] + (knuckle_x[f] - base_x[f]) * along;
-      raw[f] = std::exp(-std::pow((p.x() - axis_x) / 12, 2)) + 1e-6;
+      const double off_axis = (p - starts[f] - t * (knuckles[f] - starts[f])).dot(across);
+      raw[f] = std::exp(-std::pow(off_axis / 12, 2)) + 1e-6;
       sum += raw[f];
     }
     for (int f = 0; f < 4; ++f) {
@@ -228,13 +263,16 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     if (to_wrist > 0) weights.bones.emplace_back(0, static_cast<float>(to_wrist));
     return weights;
   };
-  AppendCapsule(model, BoneFrame({0, 0, 8}, Eigen::Vector3d::UnitZ(), palm), palm_length,
-                palm_radius, 12,
+  // BoneFrame's z, and the palm frame's third axis, point into the palm.
+  const Eigen::Vector3d palm_origin =
+      base + palm_start * along + options.palm_palmar_offset_mm * palm_rotation.col(2);
+  AppendCapsule(model, Rigid3(palm_rotation, palm_origin), palm_length, palm_radius, 12,
                 {options.palm_thickness_mm / options.palm_base_width_mm, 3.0,
                  options.palm_width_mm / options.palm_base_width_mm},
                 segments * 2, palm_weights);
   // The wrist: a shorter, flat capsule on the root bone.
-  AppendCapsule(model, model.model_from_bone_rest[0], wrist, options.wrist_width_mm / 2, 10,
+  AppendCapsule(model, Shifted(model.model_from_bone_rest[0], options.wrist_palmar_offset_mm),
+                model.bones[0].length_mm, options.wrist_width_mm / 2, 10,
                 {options.wrist_thickness_mm / options.wrist_width_mm, 2.0}, segments * 2,
                 JointBlendWeights(model, 0));
   // Fingers and thumb: round capsules on the phalanges and the thumb's metacarpal.
@@ -253,8 +291,11 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     const double radius = options.finger_radius_mm[finger] * (metacarpal ? 1.3 : taper);
     double length = model.bones[bone].length_mm;
     if (distal) length = std::max(0.3 * length, length - radius + kTipBeyondEndMm);
-    AppendCapsule(model, model.model_from_bone_rest[bone], length, radius, radius,
-                  {metacarpal ? 0.7 : 0.9, 2.0}, segments, JointBlendWeights(model, bone));
+    const double flatten = metacarpal ? 0.7 : 0.9;
+    // BoneFrame's z points into the palm; the thumb's bones run in their skin's middle.
+    const double palmar = finger < 4 ? options.finger_palmar_offset * flatten * radius : 0.0;
+    AppendCapsule(model, Shifted(model.model_from_bone_rest[bone], palmar), length, radius, radius,
+                  {flatten, 2.0}, segments, JointBlendWeights(model, bone));
   }
   model.rest_mesh.ComputeVertexNormals();
   model.Check();

@@ -11,31 +11,58 @@
 namespace ihs::tracker {
 
 /// Dimensions of the procedural hand (mm). Defaults: an adult right hand (bone lengths of the
-/// paper's scanned hand).
+/// paper's scanned hand; the knuckles on a line across the palm, the bones in their skin's middle).
 struct ProceduralHandOptions {
-  /// Wrist (root) bone length.
-  double wrist_length_mm = 17.6;
-  /// Fingers pinky, ring, middle, index: metacarpal, proximal, middle, distal phalanx.
-  std::array<std::array<double, 4>, 4> finger_lengths_mm = {{{70.1, 28.5, 18.9, 19.1},
-                                                             {72.5, 36.8, 24.8, 21.9},
-                                                             {74.9, 41.1, 25.8, 22.2},
-                                                             {76.3, 37.7, 21.1, 21.6}}};
-  /// Thumb: metacarpal, proximal, distal phalanx.
-  std::array<double, 3> thumb_lengths_mm = {52.6, 33.5, 25.2};
+  /// Where the palm's joints lie in the rest pose, relative to the wrist joint (the root bone's
+  /// end), for a right hand: x toward the thumb, y out of the back of the hand, z toward the
+  /// fingers (a left hand mirrors y). The scanned hand's, tried on 2026-11-25 (docs/tracker.md,
+  /// "Known limits"): wrist start (0.3, −5.7, −16.6); metacarpal starts (−10.4, −3.1, −4.4),
+  /// (−5.6, −0.7, −1.8), (0, 0, 0), (6.0, −0.5, −0.4); knuckles (−42.8, −3.4, 57.9),
+  /// (−24.9, 11.3, 67.1), (−6.0, 15.6, 73.0), (15.7, 14.9, 73.7) — they arch toward the back of
+  /// the hand and fall back toward the little finger.
+  /// Start of the root (wrist) bone.
+  std::array<double, 3> wrist_start_mm = {0.0, 0.0, -17.6};
+  /// Start of the metacarpal of pinky, ring, middle, index and thumb.
+  std::array<std::array<double, 3>, 5> metacarpal_start_mm = {
+      {{-15, 0, 0}, {-5, 0, 0}, {5, 0, 0}, {15, 0, 0}, {18, -4, 5}}};
+  /// End of the metacarpal (the knuckle, where the proximal phalanx starts) of pinky, ring,
+  /// middle, index and thumb (the thumb's: 52.6 mm from its start along (0.75, −0.25, 0.6), 15°
+  /// toward the palm).
+  std::array<std::array<double, 3>, 5> metacarpal_end_mm = {
+      {{-30, 0, 70.1},
+       {-10, 0, 72.5},
+       {10, 0, 74.9},
+       {30, 0, 76.3},
+       {57.749245755, -17.249748585, 36.799396604}}};
+  /// Fingers pinky, ring, middle, index: proximal, middle, distal phalanx. They go on in their
+  /// metacarpal's direction in the rest pose.
+  std::array<std::array<double, 3>, 4> finger_lengths_mm = {
+      {{28.5, 18.9, 19.1}, {36.8, 24.8, 21.9}, {41.1, 25.8, 22.2}, {37.7, 21.1, 21.6}}};
+  /// Thumb: proximal and distal phalanx.
+  std::array<double, 2> thumb_lengths_mm = {33.5, 25.2};
   /// Radius of the proximal phalanx of pinky, ring, middle, index, thumb: half the adult
   /// finger breadth at the proximal joint (mean of men and women: index ≈ 19.5 mm, thumb ≈ 21 mm).
   std::array<double, 5> finger_radius_mm = {8.3, 9.2, 9.7, 9.5, 10.5};
   /// Radius of the distal phalanx relative to the proximal one (breadth at the distal joint ≈
   /// 0.85 of that at the proximal joint); the middle phalanx lies halfway.
   double distal_taper = 0.85;
-  /// Palm breadth across the metacarpal heads (the knuckles) and thickness there (adult mean ≈
-  /// 85 × 28 mm); breadth at the wrist crease (≈ 0.8 of that at the knuckles).
+  /// Palm breadth across the metacarpal heads (the knuckles; adult mean ≈ 85 mm) and at the
+  /// wrist crease (≈ 0.8 of that), and its thickness (the scanned hand: 36 mm halfway along the
+  /// metacarpals, 31 mm near the knuckles; adult mean at the knuckles ≈ 28 mm).
   double palm_width_mm = 84.0;
   double palm_base_width_mm = 68.0;
   double palm_thickness_mm = 28.0;
-  /// Wrist breadth and thickness (adult mean ≈ 60 × 40 mm).
+  /// Wrist breadth and thickness (the scanned hand: 57 × 45 mm; adult mean ≈ 60 × 40 mm).
   double wrist_width_mm = 60.0;
   double wrist_thickness_mm = 38.0;
+  /// How far the skin's middle lies toward the palm from the bones: wrist and palm in mm, the
+  /// fingers' phalanges as a share of the phalanx's half thickness. 0: the skin centred on its
+  /// bones. A hand's bones run near its back (the scanned hand: wrist 11.5, palm 9–11 mm;
+  /// proximal, middle and distal phalanges 3.7, 2.8 and 1.8 mm, 0.30–0.38 of their half
+  /// thickness; the thumb's phalanges and metacarpal sit in their skin's middle).
+  double wrist_palmar_offset_mm = 0.0;
+  double palm_palmar_offset_mm = 0.0;
+  double finger_palmar_offset = 0.0;
   /// Segments around each capsule.
   int segments = 16;
   /// A right hand (the paper's scanned hand is one); false builds its mirror image, a left hand.

@@ -126,6 +126,108 @@ TEST(ProceduralHandTest, ALeftHandIsTheRightOnesMirrorImage) {
     EXPECT_LT((left_joints[j] - right_joints[j].cwiseProduct(mirror)).norm(), 1e-9) << j;
 }
 
+// Whether `point` lies inside the closed `mesh`, a union of overlapping closed surfaces: a ray
+// from it leaves the surfaces more often than it enters them (outward faces).
+bool Inside(const TriangleMesh& mesh, const Eigen::Vector3d& point) {
+  const Eigen::Vector3d ray = Eigen::Vector3d(0.31, 0.52, 0.8).normalized();
+  int exits = 0;
+  for (const auto& face : mesh.faces) {
+    const Eigen::Vector3d a = mesh.vertices[face[0]].cast<double>();
+    const Eigen::Vector3d e1 = mesh.vertices[face[1]].cast<double>() - a;
+    const Eigen::Vector3d e2 = mesh.vertices[face[2]].cast<double>() - a;
+    const Eigen::Vector3d p = ray.cross(e2);
+    const double det = e1.dot(p);
+    if (std::abs(det) < 1e-12) continue;
+    const Eigen::Vector3d s = point - a;
+    const double u = s.dot(p) / det, v = ray.dot(s.cross(e1)) / det;
+    if (u < 0 || v < 0 || u + v > 1) continue;
+    if (e2.dot(s.cross(e1)) / det > 0) exits += det < 0 ? 1 : -1;  // det < 0: leaving.
+  }
+  return exits > 0;
+}
+
+// The scanned hand's wrist and knuckle places (ProceduralHandOptions' comment), its skin toward
+// the palm from the bones.
+ProceduralHandOptions ScannedLayout() {
+  ProceduralHandOptions options;
+  options.wrist_start_mm = {0.3, -5.7, -16.6};
+  options.metacarpal_start_mm = {
+      {{-10.4, -3.1, -4.4}, {-5.6, -0.7, -1.8}, {0, 0, 0}, {6.0, -0.5, -0.4}, {18, -4, 5}}};
+  options.metacarpal_end_mm = {{{-42.8, -3.4, 57.9},
+                                {-24.9, 11.3, 67.1},
+                                {-6.0, 15.6, 73.0},
+                                {15.7, 14.9, 73.7},
+                                options.metacarpal_end_mm[4]}};
+  options.palm_thickness_mm = 32;
+  options.wrist_thickness_mm = 44;
+  options.wrist_palmar_offset_mm = 11;
+  options.palm_palmar_offset_mm = 9;
+  options.finger_palmar_offset = 0.35;
+  return options;
+}
+
+TEST(ProceduralHandTest, EveryBoneRunsInsideTheSkin) {
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool right = variant % 2 == 0;
+    ProceduralHandOptions options = variant < 2 ? ProceduralHandOptions() : ScannedLayout();
+    options.right_hand = right;
+    EXPECT_TRUE(IsRightHand(MakeProceduralHand(options)) == right);
+    const HandModel hand = MakeProceduralHand(options);
+    const auto joints = hand.JointPositions(ForwardKinematics(hand, HandPose::Rest(hand)));
+    for (size_t b = 0; b < hand.bones.size(); ++b) {
+      // Joint b + 1 is bone b's end; a finger bone starts at its parent's end, the metacarpals
+      // and the root at the places the model gives.
+      const Eigen::Vector3d start = hand.model_from_bone_rest[b].translation();
+      for (double t : {0.1, 0.5, 0.9}) {
+        const Eigen::Vector3d point = start + t * (joints[b + 1] - start);
+        EXPECT_TRUE(Inside(hand.rest_mesh, point)) << hand.bones[b].name << " at " << t;
+      }
+    }
+  }
+}
+
+TEST(ProceduralHandTest, PlacesItsWristAndKnucklesWhereTheOptionsSay) {
+  const HandModel hand = MakeProceduralHand(ScannedLayout());
+  EXPECT_TRUE(hand.rest_mesh.IsWatertight());
+  const auto joints = hand.JointPositions(ForwardKinematics(hand, HandPose::Rest(hand)));
+  // Joint 1 is the wrist joint (the origin of the options' places), 2, 6, 10, 14 the knuckles.
+  EXPECT_LT(joints[1].norm(), 1e-9);
+  EXPECT_LT((joints[0] - Eigen::Vector3d(0.3, -5.7, -16.6)).norm(), 1e-9);
+  EXPECT_LT((joints[2] - Eigen::Vector3d(-42.8, -3.4, 57.9)).norm(), 1e-9);
+  EXPECT_LT((joints[14] - Eigen::Vector3d(15.7, 14.9, 73.7)).norm(), 1e-9);
+  // The wrist's skin (the vertices on the root bone alone) has its middle 11 mm into the palm
+  // from the bone (BoneFrame's z); the default's on the bone.
+  for (const auto& [options, palmar] : {std::pair{ScannedLayout(), 11.0}, {{}, 0.0}}) {
+    const HandModel model = MakeProceduralHand(options);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (size_t v = 0; v < model.rest_mesh.vertices.size(); ++v) {
+      const auto& bones = model.weights[v].bones;
+      if (bones.size() != 1 || bones[0].first != 0) continue;
+      sum += model.rest_mesh.vertices[v].cast<double>();
+      ++count;
+    }
+    ASSERT_GT(count, 100);
+    const Rigid3& wrist = model.model_from_bone_rest[0];
+    EXPECT_NEAR((sum / count - wrist.translation()).dot(wrist.rotation().col(2)), palmar, 0.01);
+  }
+  // Where the scanned hand is at hand, its rest joints: the same places.
+  const auto data = test::HandDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data is absent: the scanned hand not compared";
+  const HandModel scanned = LoadHandModel(data);
+  const auto truth = scanned.JointPositions(ForwardKinematics(scanned, HandPose::Rest(scanned)));
+  for (int j : {0, 2, 6, 10, 14}) {
+    EXPECT_LT(((joints[j] - joints[1]) - (truth[j] - truth[1])).norm(), 0.2) << "joint " << j;
+  }
+  EXPECT_THROW(
+      [] {
+        ProceduralHandOptions bad;
+        bad.finger_palmar_offset = 1.5;
+        MakeProceduralHand(bad);
+      }(),
+      std::invalid_argument);
+}
+
 TEST(ProceduralHandTest, RendersAsAHandSizedBlobInFrontOfTheCamera) {
   const HandModel hand = MakeProceduralHand();
   render::OffscreenRenderer renderer(CameraIntrinsics{});
