@@ -135,10 +135,11 @@ void ProceduralHandOptions::Check() const {
     return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
   };
   IHS_CHECK_ARG(norm(wrist_start_mm, {0, 0, 0}) > 1, "hand.wrist_start_mm must not be the wrist");
-  for (int f = 0; f < 5; ++f) {
+  for (int f = 0; f < 4; ++f) {
     IHS_CHECK_ARG(norm(metacarpal_start_mm[f], metacarpal_end_mm[f]) > 1,
                   "hand.metacarpal_end_mm must lie away from its metacarpal_start_mm");
   }
+  IHS_CHECK_ARG(norm(thumb_direction, {0, 0, 0}) > 1e-6, "hand.thumb_direction must not be 0");
   for (const auto& finger : finger_lengths_mm) {
     for (double length : finger)
       IHS_CHECK_ARG(length > 0, "hand.finger_lengths_mm must be positive");
@@ -201,17 +202,19 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   const char* names[4] = {"Hand", "0", "1", "2"};
   for (int f = 0; f < 5; ++f) {
     const bool thumb = f == 4;
-    const Eigen::Vector3d start = place(options.metacarpal_start_mm[f]);
-    const Eigen::Vector3d knuckle = place(options.metacarpal_end_mm[f]);
-    std::vector<double> lengths = {(knuckle - start).norm()};
+    std::vector<double> lengths;
+    Rigid3 frame;
     if (thumb) {
-      lengths.insert(lengths.end(), options.thumb_lengths_mm.begin(),
-                     options.thumb_lengths_mm.end());
+      lengths.assign(options.thumb_lengths_mm.begin(), options.thumb_lengths_mm.end());
+      frame = BoneFrame(place(options.thumb_start_mm), place(options.thumb_direction), palm);
     } else {
+      const Eigen::Vector3d start = place(options.metacarpal_start_mm[f]);
+      const Eigen::Vector3d knuckle = place(options.metacarpal_end_mm[f]);
+      lengths = {(knuckle - start).norm()};
       lengths.insert(lengths.end(), options.finger_lengths_mm[f].begin(),
                      options.finger_lengths_mm[f].end());
+      frame = BoneFrame(start, knuckle - start, palm);
     }
-    Rigid3 frame = BoneFrame(start, knuckle - start, palm);
     int parent = 0;
     for (size_t k = 0; k < lengths.size(); ++k) {
       parent = add_bone("RFing." + std::to_string(f) + "_" + names[k], parent, lengths[k], frame,

@@ -22,24 +22,23 @@ struct ProceduralHandOptions {
   /// the hand and fall back toward the little finger.
   /// Start of the root (wrist) bone.
   std::array<double, 3> wrist_start_mm = {0.0, 0.0, -17.6};
-  /// Start of the metacarpal of pinky, ring, middle, index and thumb.
-  std::array<std::array<double, 3>, 5> metacarpal_start_mm = {
-      {{-15, 0, 0}, {-5, 0, 0}, {5, 0, 0}, {15, 0, 0}, {18, -4, 5}}};
+  /// Start of the metacarpal of pinky, ring, middle and index.
+  std::array<std::array<double, 3>, 4> metacarpal_start_mm = {
+      {{-15, 0, 0}, {-5, 0, 0}, {5, 0, 0}, {15, 0, 0}}};
   /// End of the metacarpal (the knuckle, where the proximal phalanx starts) of pinky, ring,
-  /// middle, index and thumb (the thumb's: 52.6 mm from its start along (0.75, −0.25, 0.6), 15°
-  /// toward the palm).
-  std::array<std::array<double, 3>, 5> metacarpal_end_mm = {
-      {{-30, 0, 70.1},
-       {-10, 0, 72.5},
-       {10, 0, 74.9},
-       {30, 0, 76.3},
-       {57.749245755, -17.249748585, 36.799396604}}};
+  /// middle and index.
+  std::array<std::array<double, 3>, 4> metacarpal_end_mm = {
+      {{-30, 0, 70.1}, {-10, 0, 72.5}, {10, 0, 74.9}, {30, 0, 76.3}}};
+  /// The thumb's metacarpal: its start and its direction (toward the thumb and the fingers,
+  /// turned 15° toward the palm).
+  std::array<double, 3> thumb_start_mm = {18, -4, 5};
+  std::array<double, 3> thumb_direction = {0.75, -0.25, 0.6};
   /// Fingers pinky, ring, middle, index: proximal, middle, distal phalanx. They go on in their
   /// metacarpal's direction in the rest pose.
   std::array<std::array<double, 3>, 4> finger_lengths_mm = {
       {{28.5, 18.9, 19.1}, {36.8, 24.8, 21.9}, {41.1, 25.8, 22.2}, {37.7, 21.1, 21.6}}};
-  /// Thumb: proximal and distal phalanx.
-  std::array<double, 2> thumb_lengths_mm = {33.5, 25.2};
+  /// Thumb: metacarpal, proximal and distal phalanx.
+  std::array<double, 3> thumb_lengths_mm = {52.6, 33.5, 25.2};
   /// Radius of the proximal phalanx of pinky, ring, middle, index, thumb: half the adult
   /// finger breadth at the proximal joint (mean of men and women: index ≈ 19.5 mm, thumb ≈ 21 mm).
   std::array<double, 5> finger_radius_mm = {8.3, 9.2, 9.7, 9.5, 10.5};

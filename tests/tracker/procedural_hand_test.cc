@@ -152,12 +152,9 @@ ProceduralHandOptions ScannedLayout() {
   ProceduralHandOptions options;
   options.wrist_start_mm = {0.3, -5.7, -16.6};
   options.metacarpal_start_mm = {
-      {{-10.4, -3.1, -4.4}, {-5.6, -0.7, -1.8}, {0, 0, 0}, {6.0, -0.5, -0.4}, {18, -4, 5}}};
-  options.metacarpal_end_mm = {{{-42.8, -3.4, 57.9},
-                                {-24.9, 11.3, 67.1},
-                                {-6.0, 15.6, 73.0},
-                                {15.7, 14.9, 73.7},
-                                options.metacarpal_end_mm[4]}};
+      {{-10.4, -3.1, -4.4}, {-5.6, -0.7, -1.8}, {0, 0, 0}, {6.0, -0.5, -0.4}}};
+  options.metacarpal_end_mm = {
+      {{-42.8, -3.4, 57.9}, {-24.9, 11.3, 67.1}, {-6.0, 15.6, 73.0}, {15.7, 14.9, 73.7}}};
   options.palm_thickness_mm = 32;
   options.wrist_thickness_mm = 44;
   options.wrist_palmar_offset_mm = 11;
