@@ -189,6 +189,11 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
     return Eigen::Vector3d(p[0], right ? p[1] : -p[1], p[2]);
   };
   const Eigen::Vector3d wrist_start = place(options.wrist_start_mm);
+  std::array<Eigen::Vector3d, 4> starts, knuckles;  // Fingers' metacarpals, pinky to index.
+  for (int f = 0; f < 4; ++f) {
+    starts[f] = place(options.metacarpal_start_mm[f]);
+    knuckles[f] = place(options.metacarpal_end_mm[f]);
+  }
   add_bone("Lower Arm R", -1, wrist_start.norm(), BoneFrame(wrist_start, -wrist_start, palm), root);
 
   // Fingers 0..3 (pinky to index) and the thumb (4): metacarpals fan out from the wrist to the
@@ -208,12 +213,10 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
       lengths.assign(options.thumb_lengths_mm.begin(), options.thumb_lengths_mm.end());
       frame = BoneFrame(place(options.thumb_start_mm), place(options.thumb_direction), palm);
     } else {
-      const Eigen::Vector3d start = place(options.metacarpal_start_mm[f]);
-      const Eigen::Vector3d knuckle = place(options.metacarpal_end_mm[f]);
-      lengths = {(knuckle - start).norm()};
+      lengths = {(knuckles[f] - starts[f]).norm()};
       lengths.insert(lengths.end(), options.finger_lengths_mm[f].begin(),
                      options.finger_lengths_mm[f].end());
-      frame = BoneFrame(start, knuckle - start, palm);
+      frame = BoneFrame(starts[f], knuckles[f] - starts[f], palm);
     }
     int parent = 0;
     for (size_t k = 0; k < lengths.size(); ++k) {
@@ -228,12 +231,9 @@ HandModel MakeProceduralHand(const ProceduralHandOptions& options) {
   // across the palm (and to the wrist near its start).
   const int segments = options.segments;
   std::array<int, 4> metacarpals;
-  std::array<Eigen::Vector3d, 4> starts, knuckles;
   Eigen::Vector3d base = Eigen::Vector3d::Zero(), top = Eigen::Vector3d::Zero();
   for (int f = 0; f < 4; ++f) {
     metacarpals[f] = model.BoneIndex("RFing." + std::to_string(f) + "_Hand");
-    starts[f] = place(options.metacarpal_start_mm[f]);
-    knuckles[f] = place(options.metacarpal_end_mm[f]);
     base += starts[f] / 4;
     top += knuckles[f] / 4;
   }

@@ -168,8 +168,8 @@ TEST(ProceduralHandTest, EveryBoneRunsInsideTheSkin) {
     const bool right = variant % 2 == 0;
     ProceduralHandOptions options = variant < 2 ? ProceduralHandOptions() : ScannedLayout();
     options.right_hand = right;
-    EXPECT_TRUE(IsRightHand(MakeProceduralHand(options)) == right);
     const HandModel hand = MakeProceduralHand(options);
+    EXPECT_EQ(IsRightHand(hand), right);
     const auto joints = hand.JointPositions(ForwardKinematics(hand, HandPose::Rest(hand)));
     for (size_t b = 0; b < hand.bones.size(); ++b) {
       // Joint b + 1 is bone b's end; a finger bone starts at its parent's end, the metacarpals
