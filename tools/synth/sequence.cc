@@ -96,6 +96,14 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     : options_(options),
       object_(ObjectShape::FromSpec((options.Check(), options.object), options.textured,
                                     options.object_rgb)) {
+  auto check_range = [&](int available) {
+    const int last = options_.last_frame < 0 ? available - 1 : options_.last_frame;
+    if (options_.first_frame >= available || last >= available) {
+      throw std::invalid_argument("frames " + std::to_string(options_.first_frame) + ":" +
+                                  std::to_string(last) +
+                                  " outside the motion's 0:" + std::to_string(available - 1));
+    }
+  };
   const bool recorded = options_.motion != "scripted";
   if (recorded) {
     const fs::path session = options_.motion.substr(9);
@@ -108,18 +116,17 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     hand_ = std::move(recording.model);
     hand_source_ = data_dir.string();
   } else {
+    // A scripted motion's length is known before it is planned (seconds of inverse kinematics,
+    // minutes under a sanitizer): a range outside it fails at once.
+    check_range(options_.scripted.frames);
     hand_ = tracker::LoadHandTemplate(options_.hand, !options_.left_hand);
     hand_source_ = options_.hand;
     if (options_.hand_scale != 1.0) hand_ = hand_.Scaled(options_.hand_scale);
     motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }
   const int available = static_cast<int>(motion_.frames.size());
+  check_range(available);
   last_ = options_.last_frame < 0 ? available - 1 : options_.last_frame;
-  if (options_.first_frame >= available || last_ >= available) {
-    throw std::invalid_argument("frames " + std::to_string(options_.first_frame) + ":" +
-                                std::to_string(last_) +
-                                " outside the motion's 0:" + std::to_string(available - 1));
-  }
   object_mesh_ = object_.mesh();
   if (!object_.textured())
     object_mesh_.colors.assign(object_mesh_.vertices.size(), options_.object_rgb);
