@@ -74,6 +74,8 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "neighbouring pixels join one region when their depths differ by at most this, mm");
   r.Add("tracker.segmentation.min_region_pixels", &s.min_region_pixels,
         "regions smaller than this many pixels are dropped");
+  r.Add("tracker.segmentation.connect_gap_px", &s.connect_gap_px,
+        "pixels also join a region across this many pixels without depth (0: neighbours only)");
   r.Add("tracker.segmentation.boundary_px", &s.boundary_px,
         "object pixels this close to the hand are left out");
   r.Add("tracker.segmentation.max_object_distance_mm", &s.max_object_distance_mm,
@@ -101,6 +103,8 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("tracker.fit.silhouette_weight", &f.silhouette_weight, "weight of the silhouette term");
   r.Add("tracker.fit.silhouette_tolerance_px", &f.silhouette_tolerance_px,
         "model points this close to the silhouette count as inside, px");
+  r.Add("tracker.fit.unlabelled_match_mm", &f.unlabelled_match_mm,
+        "a seen model point is paired with an unsegmented depth pixel this near, mm (0: never)");
   r.Add("tracker.fit.initial_trust_radius", &f.initial_trust_radius,
         "initial Levenberg-Marquardt trust region");
   tracker::ContactOptions& c = t.contacts;

@@ -240,6 +240,7 @@ void HandFitOptions::Check() const {
                 "hand_fit.max_correspondence_mm and robust_scale_mm must be positive");
   IHS_CHECK_ARG(limit_weight >= 0 && prior_weight >= 0,
                 "hand_fit.limit_weight and prior_weight must be >= 0");
+  IHS_CHECK_ARG(unlabelled_match_mm >= 0, "hand_fit.unlabelled_match_mm must be >= 0");
   IHS_CHECK_ARG(initial_trust_radius > 0, "hand_fit.initial_trust_radius must be positive");
   IHS_CHECK_ARG(data_point_weight >= 0, "hand_fit.data_point_weight must be >= 0");
   IHS_CHECK_ARG(silhouette_weight >= 0 && silhouette_tolerance_px >= 0,
@@ -424,6 +425,20 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     }
     roi = {std::max(0, roi[0]), std::max(0, roi[1]), std::min(segmentation->width, roi[2]),
            std::min(segmentation->height, roi[3])};
+    // With unlabelled_match_mm, what the segmentation left out (depth in the crop volume) is
+    // inside the silhouette too.
+    if (options_.unlabelled_match_mm > 0 && frame != nullptr &&
+        frame->depth_mm.size() == silhouette.size()) {
+      for (int v = roi[1]; v < roi[3]; ++v) {
+        for (int u = roi[0]; u < roi[2]; ++u) {
+          const size_t at = static_cast<size_t>(v) * segmentation->width + u;
+          if (silhouette[at] || frame->depth_mm[at] == 0) continue;
+          const Eigen::Vector3d x = intrinsics_.BackProject(u, v, frame->depth_mm[at]);
+          silhouette[at] = (x.array() >= options_.crop_min_mm.array()).all() &&
+                           (x.array() <= options_.crop_max_mm.array()).all();
+        }
+      }
+    }
     if (roi[2] > roi[0] && roi[3] > roi[1])
       nearest_silhouette = NearestSetPixels(silhouette, segmentation->width, roi);
   };
@@ -462,6 +477,42 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
     return pairs;
   };
 
+  // The nearest point, within unlabelled_match_mm, of the depth pixels around a model point's
+  // image that neither mask holds (see HandFitOptions).
+  auto nearest_unlabelled = [&](const Eigen::Vector3f& point, Eigen::Vector3d* out) {
+    if (options_.unlabelled_match_mm <= 0 || frame == nullptr || segmentation == nullptr ||
+        segmentation->hand_mask.size() != frame->depth_mm.size() ||
+        segmentation->object_mask.size() != frame->depth_mm.size()) {
+      return std::numeric_limits<double>::infinity();
+    }
+    constexpr int kRadiusPx = 2;
+    const Eigen::Vector3d p = point.cast<double>();
+    const Eigen::Vector2d pixel = intrinsics_.Project(p);
+    const int u0 = static_cast<int>(std::lround(pixel.x()));
+    const int v0 = static_cast<int>(std::lround(pixel.y()));
+    double best = options_.unlabelled_match_mm;
+    bool found = false;
+    for (int v = std::max(0, v0 - kRadiusPx); v <= std::min(frame->height - 1, v0 + kRadiusPx);
+         ++v) {
+      for (int u = std::max(0, u0 - kRadiusPx); u <= std::min(frame->width - 1, u0 + kRadiusPx);
+           ++u) {
+        const size_t at = static_cast<size_t>(v) * frame->width + u;
+        const std::uint16_t z = frame->depth_mm[at];
+        if (z == 0 || segmentation->hand_mask[at] != 0 || segmentation->object_mask[at] != 0) {
+          continue;
+        }
+        const Eigen::Vector3d q = intrinsics_.BackProject(u, v, z);
+        const double d = (q - p).norm();
+        if (d < best) {
+          best = d;
+          *out = q;
+          found = true;
+        }
+      }
+    }
+    return found ? best : std::numeric_limits<double>::infinity();
+  };
+
   std::vector<int> visible_samples;
   for (int outer = 0; outer < options_.outer_iterations; ++outer) {
     pose_samples(pose);
@@ -477,8 +528,17 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
       const int i = visible_samples[k];
       float d2 = 0;
       const int j = data_tree.Nearest(posed[i], &d2);
-      const double d = std::sqrt(d2);
-      if (j < 0 || d > options_.max_correspondence_mm) continue;
+      const double d = j >= 0 ? std::sqrt(d2) : std::numeric_limits<double>::infinity();
+      // A nearer surface that the segmentation left out instead (HandFitOptions).
+      if (d > options_.unlabelled_match_mm) {
+        Eigen::Vector3d unlabelled;
+        const double du = nearest_unlabelled(posed[i], &unlabelled);
+        if (du < d) {
+          model_pairs.push_back({data_->samples[i], unlabelled, huber(du)});
+          continue;
+        }
+      }
+      if (d > options_.max_correspondence_mm) continue;
       model_pairs.push_back({data_->samples[i], data_tree.points()[j].cast<double>(), huber(d)});
     }
     // Data → model: data points to the tangent plane of their nearest sample facing the camera.

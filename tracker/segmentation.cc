@@ -13,11 +13,12 @@ namespace {
 enum Class : std::uint8_t { kNone = 0, kSkin = 1, kOther = 2 };
 
 // Labels 4-connected regions of equal class in a width × height image whose neighbouring depths
-// differ by at most `max_step_mm`; returns the region of each pixel (−1 for kNone) and fills
-// `sizes`.
+// differ by at most `max_step_mm`; a pixel's neighbour along each axis is the next one with
+// depth, up to `gap_px` pixels without depth away (the step allowed growing with the distance).
+// Returns the region of each pixel (−1 for kNone) and fills `sizes`.
 std::vector<int> Regions(const std::vector<std::uint8_t>& classes,
                          const std::vector<std::uint16_t>& depth, int width, int height,
-                         double max_step_mm, std::vector<int>* sizes) {
+                         double max_step_mm, int gap_px, std::vector<int>* sizes) {
   std::vector<int> region(classes.size(), -1);
   std::vector<int> stack;
   sizes->clear();
@@ -32,14 +33,21 @@ std::vector<int> Regions(const std::vector<std::uint8_t>& classes,
       stack.pop_back();
       ++size;
       const int u = p % width, v = p / width;
-      const int neighbours[4] = {u > 0 ? p - 1 : -1, u + 1 < width ? p + 1 : -1,
-                                 v > 0 ? p - width : -1, v + 1 < height ? p + width : -1};
-      for (int q : neighbours) {
-        if (q < 0 || region[q] >= 0 || classes[q] != classes[p]) continue;
-        if (std::abs(static_cast<int>(depth[q]) - static_cast<int>(depth[p])) > max_step_mm)
-          continue;
-        region[q] = id;
-        stack.push_back(q);
+      const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+      for (const auto& step : steps) {
+        for (int k = 1; k <= gap_px + 1; ++k) {
+          const int uu = u + k * step[0], vv = v + k * step[1];
+          if (uu < 0 || vv < 0 || uu >= width || vv >= height) break;
+          const int q = vv * width + uu;
+          if (depth[q] == 0) continue;
+          if (region[q] < 0 && classes[q] == classes[p] &&
+              std::abs(static_cast<int>(depth[q]) - static_cast<int>(depth[p])) <=
+                  k * max_step_mm) {
+            region[q] = id;
+            stack.push_back(q);
+          }
+          break;
+        }
       }
     }
     sizes->push_back(size);
@@ -55,6 +63,8 @@ void SegmentationOptions::Check() const {
   IHS_CHECK_ARG(crop_min_mm.z() > 0, "segmentation.crop_min_mm.z must be positive");
   IHS_CHECK_ARG(connect_depth_mm > 0, "segmentation.connect_depth_mm must be positive");
   IHS_CHECK_ARG(min_region_pixels >= 0, "segmentation.min_region_pixels must be >= 0");
+  IHS_CHECK_ARG(connect_gap_px >= 0 && connect_gap_px <= 8,
+                "segmentation.connect_gap_px must be in [0, 8]");
   IHS_CHECK_ARG(boundary_px >= 0 && boundary_px <= 20,
                 "segmentation.boundary_px must be in [0, 20]");
   IHS_CHECK_ARG(max_object_distance_mm > 0, "segmentation.max_object_distance_mm must be positive");
@@ -137,7 +147,7 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
   // Depth-connected regions; small ones go.
   std::vector<int> sizes;
   const std::vector<int> region =
-      Regions(classes, depth, bw, bh, options_.connect_depth_mm, &sizes);
+      Regions(classes, depth, bw, bh, options_.connect_depth_mm, options_.connect_gap_px, &sizes);
   std::vector<std::uint8_t> hand(bn, 0);
   Eigen::Vector3d hand_sum = Eigen::Vector3d::Zero();
   int hand_count = 0;

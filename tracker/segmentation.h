@@ -30,6 +30,14 @@ struct SegmentationOptions {
   double connect_depth_mm = 15.0;
   /// Regions smaller than this many pixels are dropped (speckle, stray colour).
   int min_region_pixels = 120;
+  /// Pixels also join a region across up to this many pixels without depth (in a row or a
+  /// column), the allowed depth step growing with the distance; 0: only direct neighbours (the
+  /// default). The sensor loses depth in thin lines along a finger's edges, and a finger seen
+  /// end-on or in front of the palm falls into pieces smaller than `min_region_pixels`, dropped
+  /// (the unit tests' scripted left hand, the procedural template with the scanned hand's
+  /// layout: a whole finger). Measured on twelve 300-frame stretches of the recorded motions it
+  /// was slightly worse (docs/tracker.md), hence off.
+  int connect_gap_px = 0;
   /// Object pixels within this many pixels of the hand are left out (mixed boundary pixels).
   int boundary_px = 2;
   /// Object regions whose centre is farther than this from the hand's centre are left out, mm

@@ -230,6 +230,63 @@ TEST(HandFitterTest, RecoversAPerturbedPoseOfARenderedHand) {
 namespace ihs::tracker {
 namespace {
 
+// The index finger's pixels taken out of the hand mask (as the segmentation drops a finger it
+// cut into small pieces): fitted from the true pose, the finger is pulled toward the nearest
+// hand points it keeps unless it may match the depth there (unlabelled_match_mm).
+TEST(HandFitterTest, AFingerLeftOutOfTheMaskIsHeldByTheDepthWhenAsked) {
+  synth::SequenceOptions options;
+  options.object = "sphere";
+  options.scripted.frames = 60;
+  synth::SequenceRenderer renderer(options);
+  const HandModel& model = renderer.hand();
+  const Segmenter segmenter(options.intrinsics);
+  HandFitOptions held_options;
+  held_options.unlabelled_match_mm = 10;
+  const HandFitter pulled(model, options.intrinsics), held(model, options.intrinsics, held_options);
+  const int tip = model.BoneIndex("RFing.3_2") + 1;  // Joint k + 1 ends bone k.
+  ASSERT_GT(tip, 0);
+  double pulled_error = 0, held_error = 0, whole_error = 0;
+  int frames = 0;
+  for (int i = 0; i < renderer.frame_count(); i += 6) {
+    const synth::RenderedFrame rendered = renderer.Render(i);
+    const HandPose truth = PoseFromBoneTransforms(model, rendered.cam_from_bone);
+    const Segmentation whole = segmenter.Segment(rendered.frame);
+    Segmentation s = whole;
+    const Eigen::Vector3d finger = 0.5 * (rendered.joints_mm[tip] + rendered.joints_mm[tip - 2]);
+    int removed = 0;
+    s.hand_points.clear();
+    for (size_t p = 0; p < s.hand_mask.size(); ++p) {
+      if (!s.hand_mask[p]) continue;
+      const Eigen::Vector3d x = options.intrinsics.BackProject(
+          static_cast<int>(p % s.width), static_cast<int>(p / s.width), rendered.frame.depth_mm[p]);
+      if ((x - finger).norm() < 25) {
+        s.hand_mask[p] = 0;
+        ++removed;
+      } else {
+        s.hand_points.push_back(x.cast<float>());
+      }
+    }
+    if (removed < 150) continue;  // The finger is hardly seen in this frame.
+    auto tip_error = [&](const HandFitter& fitter, const Segmentation& seen) {
+      const HandFitResult fit = fitter.Fit(seen.hand_points, &rendered.frame, truth, &seen);
+      return (model.JointPositions(ForwardKinematics(model, fit.pose))[tip] -
+              rendered.joints_mm[tip])
+          .norm();
+    };
+    const double a = tip_error(pulled, s), b = tip_error(held, s), c = tip_error(pulled, whole);
+    std::printf(
+        "frame %d: %d pixels left out, index fingertip %.2f mm off, %.2f mm held (%.2f mm with "
+        "every pixel)\n",
+        i, removed, a, b, c);
+    pulled_error += a, held_error += b, whole_error += c;
+    ++frames;
+  }
+  // Measured over frames 0, 18, 30 and 48: 9.0 mm pulled, 4.6 mm held, 2.5 mm with every pixel.
+  ASSERT_GE(frames, 3);
+  EXPECT_LT(held_error, 0.65 * pulled_error);
+  EXPECT_LT(whole_error, held_error);
+}
+
 // Tracks frames [0, frames) of a sequence from the true first pose, each fit starting from a
 // constant-velocity prediction; returns the mean joint error (mm).
 double TrackFromTheFirstPose(const synth::SequenceOptions& options) {

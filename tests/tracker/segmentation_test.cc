@@ -160,5 +160,45 @@ TEST(SegmentationTest, AnObjectReachingIntoTheCropGoesOnBeyondItUpToTheMargin) {
   EXPECT_EQ(cropped.cropped_pixels, s.cropped_pixels);
 }
 
+TEST(SegmentationTest, AFingerCutByLinesWithoutDepthIsKeptWhenRegionsJoinAcrossThem) {
+  // A skin-coloured strip at 600 mm, 6 rows by 100 columns, cut by columns without depth into
+  // five pieces of 6 × 17–19 pixels (fewer than min_region_pixels, 120): the last lies three
+  // columns beyond its neighbour, the others one.
+  Frame frame = Frame::Blank(640, 480, true);
+  std::vector<int> columns;
+  for (int u = 270; u < 370; ++u) {
+    const int k = u - 270;
+    if (k % 20 == 19 || (k >= 77 && k < 80)) continue;
+    columns.push_back(u);
+  }
+  for (int v = 240; v < 246; ++v) {
+    for (int u : columns) {
+      frame.depth_mm[v * 640 + u] = 600;
+      frame.rgb[3 * (v * 640 + u)] = 222;
+      frame.rgb[3 * (v * 640 + u) + 1] = 170;
+      frame.rgb[3 * (v * 640 + u) + 2] = 140;
+    }
+  }
+  const CameraIntrinsics intrinsics;
+  EXPECT_TRUE(Segmenter(intrinsics).Segment(frame).hand_points.empty());  // Each piece dropped.
+  SegmentationOptions joined;
+  joined.connect_gap_px = 2;
+  const Segmentation s = Segmenter(intrinsics, joined).Segment(frame);
+  // The four pieces one column apart are one region of 444 pixels; the last, three columns
+  // apart, is still too small alone.
+  size_t last_piece = 0;
+  for (int u : columns) last_piece += u >= 350;
+  EXPECT_EQ(s.hand_points.size(), 6 * (columns.size() - last_piece));
+  EXPECT_EQ(last_piece, 19u);
+  // A step in depth across a gap larger than connect_depth_mm per pixel crossed still parts:
+  // the fourth piece 40 mm farther away is dropped, the first three (3 × 19 columns) kept.
+  for (int v = 240; v < 246; ++v) {
+    for (int u = 330; u < 350; ++u) frame.depth_mm[v * 640 + u] += 40;
+  }
+  EXPECT_EQ(Segmenter(intrinsics, joined).Segment(frame).hand_points.size(), 6 * 3 * 19u);
+  joined.connect_gap_px = 9;
+  EXPECT_THROW(joined.Check(), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace ihs::tracker
