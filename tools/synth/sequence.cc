@@ -96,13 +96,15 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     : options_(options),
       object_(ObjectShape::FromSpec((options.Check(), options.object), options.textured,
                                     options.object_rgb)) {
-  auto check_range = [&](int available) {
+  // The range's last frame, checked against the motion's length.
+  auto checked_last = [&](int available) {
     const int last = options_.last_frame < 0 ? available - 1 : options_.last_frame;
     if (options_.first_frame >= available || last >= available) {
       throw std::invalid_argument("frames " + std::to_string(options_.first_frame) + ":" +
                                   std::to_string(last) +
                                   " outside the motion's 0:" + std::to_string(available - 1));
     }
+    return last;
   };
   const bool recorded = options_.motion != "scripted";
   if (recorded) {
@@ -118,15 +120,13 @@ SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
   } else {
     // A scripted motion's length is known before it is planned (seconds of inverse kinematics,
     // minutes under a sanitizer): a range outside it fails at once.
-    check_range(options_.scripted.frames);
+    checked_last(options_.scripted.frames);
     hand_ = tracker::LoadHandTemplate(options_.hand, !options_.left_hand);
     hand_source_ = options_.hand;
     if (options_.hand_scale != 1.0) hand_ = hand_.Scaled(options_.hand_scale);
     motion_ = MakeScriptedMotion(hand_, object_, options_.scripted);
   }
-  const int available = static_cast<int>(motion_.frames.size());
-  check_range(available);
-  last_ = options_.last_frame < 0 ? available - 1 : options_.last_frame;
+  last_ = checked_last(static_cast<int>(motion_.frames.size()));
   object_mesh_ = object_.mesh();
   if (!object_.textured())
     object_mesh_.colors.assign(object_mesh_.vertices.size(), options_.object_rgb);
