@@ -55,10 +55,12 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("tracker.min_hand_points", &t.min_hand_points, "hand points a frame needs to be fitted");
   r.Add("tracker.min_data_coverage", &t.min_data_coverage,
         "share of hand points within 10 mm of the model below which the fit has diverged");
-  r.Add("tracker.diverged_frames_to_reinitialise", &t.diverged_frames_to_reinitialise,
-        "diverged frames in a row before re-initialising from the hand cloud");
+  r.Add("tracker.search_data_coverage", &t.search_data_coverage,
+        "share of hand points within 10 mm of the model below which the fit is doubtful");
+  r.Add("tracker.doubtful_frames_to_search", &t.doubtful_frames_to_search,
+        "doubtful frames in a row before searching for the hand anew from the hand cloud");
   r.Add("tracker.initialisation_iterations", &t.initialisation_iterations,
-        "Levenberg-Marquardt iterations per initialisation hypothesis");
+        "Levenberg-Marquardt iterations per search hypothesis");
   r.Add("tracker.scale_frames", &t.scale_frames,
         "frames over which the template's scale is estimated (0: none)");
   r.Add("tracker.scale_range", &t.scale_range, "scale candidates span 1 ± this");

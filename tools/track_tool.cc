@@ -105,6 +105,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
     if (!result.reason.empty()) entry["reason"] = result.reason;
     if (!result.joints_mm.empty()) {
       entry["data_coverage"] = result.fit.data_coverage;
+      entry["model_coverage"] = result.fit.model_coverage;
       entry["data_error_mm"] = result.fit.data_error_mm;
       joints.push_back({index, result.joints_mm});
     }

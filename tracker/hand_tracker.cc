@@ -28,6 +28,12 @@ void PrincipalAxes(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d* 
   for (int k = 0; k < 3; ++k) axes->col(k) = solver.eigenvectors().col(2 - k);
 }
 
+// How badly a fit explains the hand (lower is better): the data's mean distance, and the shares
+// of data and of visible model points left unexplained (20 mm for none explained).
+double FitScore(const HandFitResult& fit) {
+  return fit.data_error_mm + 20.0 * (1.0 - fit.data_coverage) + 20.0 * (1.0 - fit.model_coverage);
+}
+
 }  // namespace
 
 const char* ToString(TrackStatus status) {
@@ -53,8 +59,9 @@ void TrackerOptions::Check() const {
   IHS_CHECK_ARG(min_hand_points >= 10, "tracker.min_hand_points must be >= 10");
   IHS_CHECK_ARG(min_data_coverage >= 0 && min_data_coverage <= 1,
                 "tracker.min_data_coverage must be in [0, 1]");
-  IHS_CHECK_ARG(diverged_frames_to_reinitialise >= 1,
-                "tracker.diverged_frames_to_reinitialise must be >= 1");
+  IHS_CHECK_ARG(search_data_coverage >= min_data_coverage && search_data_coverage <= 1,
+                "tracker.search_data_coverage must be in [min_data_coverage, 1]");
+  IHS_CHECK_ARG(doubtful_frames_to_search >= 1, "tracker.doubtful_frames_to_search must be >= 1");
   IHS_CHECK_ARG(initialisation_iterations >= 1, "tracker.initialisation_iterations must be >= 1");
   IHS_CHECK_ARG(scale_frames >= 0, "tracker.scale_frames must be >= 0");
   IHS_CHECK_ARG(scale_range >= 0 && scale_range < 0.5, "tracker.scale_range must be in [0, 0.5)");
@@ -171,39 +178,64 @@ void HandTracker::Initialise(const HandPose& pose) {
   pose_ = pose;
   has_pose_ = true;
   has_previous_ = false;
-  diverged_in_a_row_ = 0;
+  doubtful_in_a_row_ = 0;
+  has_confident_pose_ = false;
 }
 
-HandFitResult HandTracker::InitialiseFromCloud(const std::vector<Eigen::Vector3f>& hand_points,
-                                               const Frame& frame) const {
-  // Hypotheses: the model's principal axes (rest pose) onto the hand cloud's, each way round.
-  std::vector<Eigen::Vector3d> data, rest;
+std::vector<HandPose> HandTracker::CloudHypotheses(const std::vector<Eigen::Vector3f>& hand_points,
+                                                   const HandPose& articulation,
+                                                   bool also_unturned) const {
+  // The posed model's principal axes onto the hand cloud's, each way round: the articulation
+  // kept, the whole hand turned and moved onto the cloud.
+  std::vector<Eigen::Vector3d> data, model;
   for (const auto& p : hand_points) data.push_back(p.cast<double>());
-  for (const auto& v : model_.Pose(ForwardKinematics(model_, HandPose::Rest(model_))).vertices)
-    rest.push_back(v.cast<double>());
-  Eigen::Vector3d data_centre, rest_centre;
-  Eigen::Matrix3d data_axes, rest_axes;
+  for (const auto& v : model_.Pose(ForwardKinematics(model_, articulation)).vertices)
+    model.push_back(v.cast<double>());
+  Eigen::Vector3d data_centre, model_centre;
+  Eigen::Matrix3d data_axes, model_axes;
   PrincipalAxes(data, &data_centre, &data_axes);
-  PrincipalAxes(rest, &rest_centre, &rest_axes);
-  if (rest_axes.determinant() < 0) rest_axes.col(2) *= -1;
+  PrincipalAxes(model, &model_centre, &model_axes);
+  if (model_axes.determinant() < 0) model_axes.col(2) *= -1;
   // The cloud is the visible surface: the hand's middle lies a little farther along the ray.
   const Eigen::Vector3d centre = data_centre + 8.0 * data_centre.normalized();
-  HandFitResult best;
-  double best_score = std::numeric_limits<double>::infinity();
+  std::vector<HandPose> hypotheses;
   for (int s1 : {1, -1}) {
     for (int s2 : {1, -1}) {
       Eigen::Matrix3d axes;
       axes.col(0) = s1 * data_axes.col(0);
       axes.col(1) = s2 * data_axes.col(1);
       axes.col(2) = axes.col(0).cross(axes.col(1));
-      const Eigen::Matrix3d rotation = axes * rest_axes.transpose();
-      const Rigid3 cam_from_model(rotation, centre - rotation * rest_centre);
-      const HandFitResult fit =
-          initial_fitter_->Fit(hand_points, &frame, HandPose::Rest(model_, cam_from_model));
-      const double score =
-          fit.data_error_mm + 20.0 * (1.0 - fit.data_coverage) + 20.0 * (1.0 - fit.model_coverage);
-      if (score < best_score) best_score = score, best = fit;
+      const Eigen::Matrix3d rotation = axes * model_axes.transpose();
+      HandPose pose = articulation;
+      pose.cam_from_root = Rigid3(rotation, centre - rotation * model_centre) * pose.cam_from_root;
+      hypotheses.push_back(std::move(pose));
     }
+  }
+  if (also_unturned) {
+    // Only moved onto the cloud: a hand that moved fast but did not turn much.
+    HandPose moved = articulation;
+    moved.cam_from_root =
+        Rigid3(Eigen::Matrix3d::Identity(), centre - model_centre) * moved.cam_from_root;
+    hypotheses.push_back(std::move(moved));
+  }
+  return hypotheses;
+}
+
+std::optional<HandFitResult> HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_points,
+                                                 const Frame& frame, double score_to_beat) const {
+  std::vector<HandPose> hypotheses =
+      CloudHypotheses(hand_points, HandPose::Rest(model_), /*also_unturned=*/false);
+  if (has_confident_pose_) {
+    for (HandPose& pose : CloudHypotheses(hand_points, confident_pose_, /*also_unturned=*/true))
+      hypotheses.push_back(std::move(pose));
+  }
+  // With nothing to beat, the first hypothesis is kept even if its score is not a number.
+  const bool keep_any = !(score_to_beat < std::numeric_limits<double>::infinity());
+  std::optional<HandFitResult> best;
+  for (const HandPose& hypothesis : hypotheses) {
+    HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, hypothesis);
+    const double score = FitScore(fit);
+    if (score < score_to_beat || (keep_any && !best)) score_to_beat = score, best = std::move(fit);
   }
   return best;
 }
@@ -238,7 +270,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   }
 
   if (!has_pose_) {
-    result.fit = InitialiseFromCloud(points, frame);
+    result.fit = *Search(points, frame, std::numeric_limits<double>::infinity());
     result.status = TrackStatus::kInitialised;
   } else {
     HandPose predicted = pose_;
@@ -249,21 +281,26 @@ TrackResult HandTracker::Track(const Frame& frame) {
     result.fit = fitter_->Fit(points, &frame, predicted, &result.segmentation);
     result.status = TrackStatus::kTracked;
   }
-  if (result.fit.data_coverage < options_.min_data_coverage) {
-    ++diverged_in_a_row_;
-    if (result.status == TrackStatus::kTracked &&
-        diverged_in_a_row_ >= options_.diverged_frames_to_reinitialise) {
-      result.fit = InitialiseFromCloud(points, frame);
+  // A run of doubtful fits: search for the hand anew, the tracked fit competing.
+  doubtful_in_a_row_ =
+      result.fit.data_coverage < options_.search_data_coverage ? doubtful_in_a_row_ + 1 : 0;
+  if (result.status == TrackStatus::kTracked &&
+      doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
+    doubtful_in_a_row_ = 0;
+    if (auto found = Search(points, frame, FitScore(result.fit))) {
+      result.fit = std::move(*found);
       result.status = TrackStatus::kInitialised;
     }
+  }
+  if (result.fit.data_coverage >= options_.search_data_coverage) {
+    confident_pose_ = result.fit.pose;
+    has_confident_pose_ = true;
   }
   if (result.fit.data_coverage < options_.min_data_coverage) {
     result.status = TrackStatus::kDiverged;
     result.reason = "fit explains " +
                     std::to_string(static_cast<int>(100 * result.fit.data_coverage)) +
                     " % of the hand points";
-  } else {
-    diverged_in_a_row_ = 0;
   }
 
   previous_pose_ = pose_;

@@ -1,10 +1,12 @@
 #pragma once
 // The hand-tracker stage: per frame, segment hand and object, fit the hand model from a
-// constant-velocity prediction, detect divergence and re-initialise without stopping, and find
-// the fingertip contacts with the object. One obvious entry point: Track(frame).
+// constant-velocity prediction, search for the hand anew when the fits grow doubtful (without
+// stopping), and find the fingertip contacts with the object. One obvious entry point:
+// Track(frame).
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,11 +27,20 @@ struct TrackerOptions {
   ContactOptions contacts;
   /// A frame needs this many hand points to be fitted; with fewer it is skipped (no hand).
   int min_hand_points = 150;
-  /// A fit with fewer of the hand's points within 10 mm of the model than this has diverged.
+  /// A fit with fewer of the hand's points within 10 mm of the model than this has diverged
+  /// (the frame's pose is not used).
   double min_data_coverage = 0.75;
-  /// Diverged frames in a row before the tracker re-initialises from the hand cloud.
-  int diverged_frames_to_reinitialise = 2;
-  /// Levenberg–Marquardt iterations (outer) for each initialisation hypothesis.
+  /// A fit with fewer than this is doubtful: a hand fitted in the wrong place or turned the
+  /// wrong way round can still explain most of its points (on the generator's scripted turns,
+  /// frames with 20–90 mm joint error explained 0.92–0.94 of them, where every well tracked
+  /// frame of the recorded and scripted motions explained 0.95 or more).
+  double search_data_coverage = 0.9;
+  /// Doubtful (or diverged) frames in a row before the tracker searches for the hand anew: it
+  /// fits the hand from hypotheses placed on the hand cloud (its principal axes, each way round,
+  /// for the open hand and for the last confidently tracked pose, and that pose only moved onto
+  /// the cloud) and keeps the best explanation, the tracked fit included.
+  int doubtful_frames_to_search = 2;
+  /// Levenberg–Marquardt iterations (outer) for each search hypothesis.
   int initialisation_iterations = 8;
   /// The template's size is estimated over this many frames with a hand (0: the template is
   /// used at the size it comes in): on each, the pose is fitted at every candidate scale in
@@ -47,7 +58,7 @@ struct TrackerOptions {
 /// What happened to a frame.
 enum class TrackStatus {
   kTracked,      ///< Fitted from the previous pose.
-  kInitialised,  ///< Fitted from scratch (first frame with a hand, or after divergence).
+  kInitialised,  ///< Fitted from scratch (first frame with a hand, or a search won).
   kDiverged,     ///< Fitted, but the fit does not explain the data; not to be trusted.
   kNoHand,       ///< Skipped: too few hand points.
   kEmptyFrame,   ///< Skipped: no depth at all.
@@ -117,8 +128,14 @@ class HandTracker {
 
  private:
   struct ScaleCandidate;
-  HandFitResult InitialiseFromCloud(const std::vector<Eigen::Vector3f>& hand_points,
-                                    const Frame& frame) const;
+  // Poses of `articulation` turned and moved onto the hand cloud (its principal axes onto the
+  // cloud's, four ways round), and with `also_unturned` also only moved onto it.
+  std::vector<HandPose> CloudHypotheses(const std::vector<Eigen::Vector3f>& hand_points,
+                                        const HandPose& articulation, bool also_unturned) const;
+  // The best fit from the cloud hypotheses when it explains the hand better than `score_to_beat`
+  // (see FitScore), else nothing.
+  std::optional<HandFitResult> Search(const std::vector<Eigen::Vector3f>& hand_points,
+                                      const Frame& frame, double score_to_beat) const;
   // Builds the fitters and the contact detector for model_.
   void BuildStages();
   // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's
@@ -142,7 +159,10 @@ class HandTracker {
   HandPose pose_;
   HandPose previous_pose_;
   bool has_previous_ = false;
-  int diverged_in_a_row_ = 0;
+  int doubtful_in_a_row_ = 0;
+  // The last pose whose fit explained at least search_data_coverage of the hand points.
+  HandPose confident_pose_;
+  bool has_confident_pose_ = false;
   std::vector<Eigen::Vector3f> previous_vertices_;
   std::vector<int> previous_contact_vertices_;
 };
