@@ -186,7 +186,7 @@ TEST(HandTrackerTest, ALeftHandIsTrackedWithTheMirroredTemplate) {
 TEST(HandTrackerTest, SearchesForTheHandAnewWhenItsFitsGrowDoubtful) {
   // The scripted motion swings the hand back 90° around a water bottle between grasps (about
   // 10 mm per frame at the joints, the hand mostly behind the bottle): the tracker loses it
-  // there, and fits the hand in the wrong place that still explain 75–95 % of its points.
+  // there, and fits that put the hand in the wrong place still explain 75–95 % of its points.
   synth::SequenceOptions options;
   options.object = "water-bottle";
   options.seed = options.scripted.seed = 5;
