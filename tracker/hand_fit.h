@@ -46,13 +46,12 @@ struct HandFitOptions {
   /// Pairs farther apart than this count with a Huber weight, mm.
   double robust_scale_mm = 8.0;
   /// Weight of soft joint limits (per rad beyond a limit) and of the pull toward the initial
-  /// (predicted) joint angles (per rad), which keeps unseen fingers where they were and damps
-  /// the fingers' frame-to-frame jitter. At 5 instead of 1.5, over 22 generator sequences of the
-  /// recorded motions (eighteen 300-frame object × motion stretches and the four whole
-  /// sessions), the contact error's median exceeded 1.5 mm on 1 instead of 5, the joint error's
-  /// mean went 8.63 → 8.54 mm, and the scans came out alike (docs/tracker.md).
+  /// (predicted) joint angles (per rad), which keeps unseen fingers where they were. A firmer
+  /// pull (5) damps the fingers' jitter on the recorded motions (lower contact error) but makes
+  /// them lag fast finger motion: the scripted re-grasps' scans drifted and lost the surface
+  /// (docs/tracker.md, "A firmer pull").
   double limit_weight = 30.0;
-  double prior_weight = 5.0;
+  double prior_weight = 1.5;
   /// Weight of data → model pairs taken point to point, besides point to plane (relative to
   /// that): the planes of a finger's side let it slide along its axis, which a template of other
   /// proportions than the user's hand then does frame after frame.

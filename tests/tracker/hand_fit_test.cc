@@ -281,10 +281,9 @@ TEST(HandFitterTest, AFingerLeftOutOfTheMaskIsHeldByTheDepthWhenAsked) {
     pulled_error += a, held_error += b, whole_error += c;
     ++frames;
   }
-  // Measured over frames 0, 18, 30 and 48: 9.6 mm pulled, 7.2 mm held, 3.6 mm with every pixel
-  // (with the pull toward the predicted angles at 1.5 instead of 5: 9.0, 4.6 and 2.5 mm).
+  // Measured over frames 0, 18, 30 and 48: 9.0 mm pulled, 4.6 mm held, 2.5 mm with every pixel.
   ASSERT_GE(frames, 3);
-  EXPECT_LT(held_error, 0.85 * pulled_error);
+  EXPECT_LT(held_error, 0.65 * pulled_error);
   EXPECT_LT(whole_error, held_error);
 }
 
