@@ -32,8 +32,8 @@ struct TrackerOptions {
   double min_data_coverage = 0.75;
   /// A fit with fewer than this is doubtful: a hand fitted in the wrong place or turned the
   /// wrong way round can still explain most of its points (on the generator's scripted turns,
-  /// frames with 20–90 mm joint error explained 0.92–0.94 of them, where every well tracked
-  /// frame of the recorded and scripted motions explained 0.95 or more).
+  /// frames with 25–90 mm joint error explained a median 0.92–0.94 of them, while 99 % of the
+  /// well tracked frames of the recorded and scripted motions explained 0.95 or more).
   double search_data_coverage = 0.9;
   /// Doubtful (or diverged) frames in a row before the tracker searches for the hand anew: it
   /// fits the hand from hypotheses placed on the hand cloud (its principal axes, each way round,
