@@ -5,7 +5,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <string>
 
 #include "core/check.h"
@@ -221,21 +220,18 @@ std::vector<HandPose> HandTracker::CloudHypotheses(const std::vector<Eigen::Vect
   return hypotheses;
 }
 
-std::optional<HandFitResult> HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_points,
-                                                 const Frame& frame, double score_to_beat) const {
+HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_points,
+                                  const Frame& frame) const {
   std::vector<HandPose> hypotheses =
       CloudHypotheses(hand_points, HandPose::Rest(model_), /*also_unturned=*/false);
   if (has_confident_pose_) {
     for (HandPose& pose : CloudHypotheses(hand_points, confident_pose_, /*also_unturned=*/true))
       hypotheses.push_back(std::move(pose));
   }
-  // With nothing to beat, the first hypothesis is kept even if its score is not a number.
-  const bool keep_any = !(score_to_beat < std::numeric_limits<double>::infinity());
-  std::optional<HandFitResult> best;
-  for (const HandPose& hypothesis : hypotheses) {
-    HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, hypothesis);
-    const double score = FitScore(fit);
-    if (score < score_to_beat || (keep_any && !best)) score_to_beat = score, best = std::move(fit);
+  HandFitResult best = initial_fitter_->Fit(hand_points, &frame, hypotheses.front());
+  for (size_t k = 1; k < hypotheses.size(); ++k) {
+    HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, hypotheses[k]);
+    if (FitScore(fit) < FitScore(best)) best = std::move(fit);
   }
   return best;
 }
@@ -270,7 +266,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   }
 
   if (!has_pose_) {
-    result.fit = *Search(points, frame, std::numeric_limits<double>::infinity());
+    result.fit = Search(points, frame);
     result.status = TrackStatus::kInitialised;
   } else {
     HandPose predicted = pose_;
@@ -287,8 +283,9 @@ TrackResult HandTracker::Track(const Frame& frame) {
   if (result.status == TrackStatus::kTracked &&
       doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
     doubtful_in_a_row_ = 0;
-    if (auto found = Search(points, frame, FitScore(result.fit))) {
-      result.fit = std::move(*found);
+    HandFitResult found = Search(points, frame);
+    if (FitScore(found) < FitScore(result.fit)) {
+      result.fit = std::move(found);
       result.status = TrackStatus::kInitialised;
     }
   }

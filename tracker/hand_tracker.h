@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -132,10 +131,9 @@ class HandTracker {
   // cloud's, four ways round), and with `also_unturned` also only moved onto it.
   std::vector<HandPose> CloudHypotheses(const std::vector<Eigen::Vector3f>& hand_points,
                                         const HandPose& articulation, bool also_unturned) const;
-  // The best fit from the cloud hypotheses when it explains the hand better than `score_to_beat`
-  // (see FitScore), else nothing.
-  std::optional<HandFitResult> Search(const std::vector<Eigen::Vector3f>& hand_points,
-                                      const Frame& frame, double score_to_beat) const;
+  // The fit from the cloud hypotheses (the open hand's, and the last confident pose's) that
+  // explains the hand best.
+  HandFitResult Search(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame) const;
   // Builds the fitters and the contact detector for model_.
   void BuildStages();
   // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's
