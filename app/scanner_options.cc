@@ -91,6 +91,8 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("tracker.fit.inner_iterations", &f.inner_iterations,
         "Levenberg-Marquardt iterations per correspondence update");
   r.Add("tracker.fit.max_data_points", &f.max_data_points, "data points matched to the model");
+  r.Add("tracker.fit.data_voxel_mm", &f.data_voxel_mm,
+        "data points: centroids of the hand points in cubes of this size, mm (0: a stride)");
   r.Add("tracker.fit.max_model_points", &f.max_model_points,
         "visible model points matched to the data");
   r.Add("tracker.fit.max_correspondence_mm", &f.max_correspondence_mm,

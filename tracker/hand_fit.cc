@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "core/check.h"
@@ -23,6 +24,36 @@ constexpr double kOccluderMm = 15.0;
 // Collision capsules are thinner than the fingers: fingers that touch (as neighbours do) are not
 // penalised, only fingers that pass into each other.
 constexpr double kCapsuleShrink = 0.7;
+
+// The centroids of `points` in the cubes of a grid of `cell_mm` fixed in their frame, in the
+// cubes' order (so that a stride over them is even in space).
+std::vector<Eigen::Vector3f> VoxelCentroids(const std::vector<Eigen::Vector3f>& points,
+                                            double cell_mm) {
+  struct Keyed {
+    std::int64_t key;
+    int index;
+  };
+  std::vector<Keyed> keyed(points.size());
+  const float inverse = static_cast<float>(1.0 / cell_mm);
+  for (size_t i = 0; i < points.size(); ++i) {
+    // 21 bits per axis: cubes of a few mm cover ±(2^20 × cell) around the camera.
+    const Eigen::Vector3f c = (points[i] * inverse).array().floor();
+    auto bits = [](float v) { return static_cast<std::int64_t>(v + (1 << 20)) & 0x1FFFFF; };
+    keyed[i] = {(bits(c.z()) << 42) | (bits(c.y()) << 21) | bits(c.x()), static_cast<int>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end(),
+            [](const Keyed& a, const Keyed& b) { return a.key < b.key; });
+  std::vector<Eigen::Vector3f> centroids;
+  for (size_t begin = 0; begin < keyed.size();) {
+    size_t end = begin;
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    for (; end < keyed.size() && keyed[end].key == keyed[begin].key; ++end)
+      sum += points[keyed[end].index];
+    centroids.push_back(sum / static_cast<float>(end - begin));
+    begin = end;
+  }
+  return centroids;
+}
 
 // Closest points of segments [p0, p1] and [q0, q1]: parameters s, t in [0, 1].
 void ClosestPointsOfSegments(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
@@ -240,6 +271,7 @@ void HandFitOptions::Check() const {
                 "hand_fit.max_correspondence_mm and robust_scale_mm must be positive");
   IHS_CHECK_ARG(limit_weight >= 0 && prior_weight >= 0,
                 "hand_fit.limit_weight and prior_weight must be >= 0");
+  IHS_CHECK_ARG(data_voxel_mm >= 0, "hand_fit.data_voxel_mm must be >= 0");
   IHS_CHECK_ARG(unlabelled_match_mm >= 0, "hand_fit.unlabelled_match_mm must be >= 0");
   IHS_CHECK_ARG(initial_trust_radius > 0, "hand_fit.initial_trust_radius must be positive");
   IHS_CHECK_ARG(data_point_weight >= 0, "hand_fit.data_point_weight must be >= 0");
@@ -320,11 +352,20 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   result.pose = initial;
   if (hand_points.empty()) return result;
 
-  // Data: an even subsample for data → model, a denser one for the tree.
-  const size_t data_stride =
-      std::max<size_t>(1, hand_points.size() / static_cast<size_t>(options_.max_data_points));
-  std::vector<Eigen::Vector3f> data;
-  for (size_t i = 0; i < hand_points.size(); i += data_stride) data.push_back(hand_points[i]);
+  // Data: an even subsample for data → model (of the cubes' centroids, or of the points), a
+  // denser one for the tree. How well the pose explains the data is measured on the points
+  // themselves (every n-th), a share of the hand's pixels whichever data the fit used.
+  auto every_nth = [&](const std::vector<Eigen::Vector3f>& points) {
+    const size_t stride =
+        std::max<size_t>(1, points.size() / static_cast<size_t>(options_.max_data_points));
+    std::vector<Eigen::Vector3f> kept;
+    for (size_t i = 0; i < points.size(); i += stride) kept.push_back(points[i]);
+    return kept;
+  };
+  const std::vector<Eigen::Vector3f> measured = every_nth(hand_points);
+  const std::vector<Eigen::Vector3f> data =
+      options_.data_voxel_mm > 0 ? every_nth(VoxelCentroids(hand_points, options_.data_voxel_mm))
+                                 : measured;
   const size_t tree_stride = std::max<size_t>(1, hand_points.size() / 4000);
   std::vector<Eigen::Vector3f> tree_points;
   for (size_t i = 0; i < hand_points.size(); i += tree_stride)
@@ -612,7 +653,7 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   const PointKdTree model_tree(std::move(facing_points));
   double sum = 0;
   int covered = 0;
-  for (const Eigen::Vector3f& point : data) {
+  for (const Eigen::Vector3f& point : measured) {
     float d2 = 0;
     if (model_tree.Nearest(point, &d2) < 0) d2 = 1e6f;
     sum += std::sqrt(d2);
@@ -628,8 +669,8 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   }
   result.model_error_mm = visible_samples.empty() ? 0 : model_sum / visible_samples.size();
   result.pose = pose;
-  result.data_error_mm = sum / data.size();
-  result.data_coverage = static_cast<double>(covered) / data.size();
+  result.data_error_mm = sum / measured.size();
+  result.data_coverage = static_cast<double>(covered) / measured.size();
   result.model_coverage =
       visible_samples.empty() ? 0 : static_cast<double>(visible_covered) / visible_samples.size();
   return result;
