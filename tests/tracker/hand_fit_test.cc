@@ -188,6 +188,9 @@ TEST(HandFitOptionsTest, BadValuesAreRefusedNamingTheField) {
   options = HandFitOptions();
   options.data_point_weight = -1;
   EXPECT_NE(message(options).find("data_point_weight"), std::string::npos);
+  options = HandFitOptions();
+  options.data_voxel_mm = -1;
+  EXPECT_NE(message(options).find("data_voxel_mm"), std::string::npos);
 }
 
 TEST(HandFitterTest, RecoversAPerturbedPoseOfARenderedHand) {
