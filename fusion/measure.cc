@@ -320,4 +320,18 @@ SurfaceComparison CompareSurfaces(const TriangleMesh& scan, const TriangleMesh& 
   return result;
 }
 
+double UnseenShare(const TriangleMesh& closed, const TriangleMesh& seen, double within_mm,
+                   double spacing_mm) {
+  IHS_CHECK_ARG(within_mm > 0 && spacing_mm > 0,
+                "UnseenShare needs positive distances, got " << within_mm << " and " << spacing_mm);
+  const std::vector<Eigen::Vector3f> closed_samples = SampleSurface(closed, spacing_mm);
+  if (closed_samples.empty()) return 0;
+  const std::vector<Eigen::Vector3f> seen_samples = SampleSurface(seen, spacing_mm);
+  if (seen_samples.empty()) return 1;
+  const std::vector<double> to_seen = NearestDistances(closed_samples, seen_samples);
+  return static_cast<double>(std::count_if(to_seen.begin(), to_seen.end(),
+                                           [&](double d) { return d > within_mm; })) /
+         to_seen.size();
+}
+
 }  // namespace ihs::fusion

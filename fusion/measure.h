@@ -60,6 +60,14 @@ struct SurfaceComparison {
 SurfaceComparison CompareSurfaces(const TriangleMesh& scan, const TriangleMesh& truth,
                                   double within_mm = 2.0, double spacing_mm = 0.25);
 
+/// Share of the area of `closed` (a watertight mesh made from `seen`) farther than `within_mm`
+/// from `seen`: the part of the closed surface that no frame observed and that Poisson made up.
+/// A volume measured on a watertight mesh is only as good as this share is small: where half a
+/// sphere was never seen, the closure's volume follows Poisson's bounding cube more than the data
+/// (docs/fusion.md). In [0, 1]; 0 for an empty `closed`, 1 for an empty `seen`.
+double UnseenShare(const TriangleMesh& closed, const TriangleMesh& seen, double within_mm = 2.0,
+                   double spacing_mm = 0.5);
+
 /// Points spread over the surface of `mesh`, one per `spacing_mm`² of area on average
 /// (deterministic), but at most about `max_samples`: a larger surface (a scan that lost the object
 /// and smeared it over metres) is sampled more sparsely instead of filling the memory.

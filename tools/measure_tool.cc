@@ -26,9 +26,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-int Run(const std::string& mesh_path, const std::string& object, const std::string& gt,
-        std::string trajectory_path, const std::string& json_path) {
+int Run(const std::string& mesh_path, const std::string& seen_path, const std::string& object,
+        const std::string& gt, std::string trajectory_path, const std::string& json_path) {
   const ihs::TriangleMesh mesh = ihs::ReadMesh(mesh_path);
+  const ihs::TriangleMesh seen = seen_path.empty() ? ihs::TriangleMesh{} : ihs::ReadMesh(seen_path);
   const ihs::fusion::RevolutionMeasures measures = ihs::fusion::MeasureRevolution(mesh);
   nlohmann::json out = {{"mesh", mesh_path},
                         {"faces", mesh.faces.size()},
@@ -56,7 +57,8 @@ int Run(const std::string& mesh_path, const std::string& object, const std::stri
     }
     trajectory = ihs::ReadTumTrajectory(trajectory_path);
   }
-  out.update(ihs::eval::ReportScan(object, mesh, mesh, gt, trajectory));
+  out.update(seen_path.empty() ? ihs::eval::ReportScan(object, mesh, mesh, gt, trajectory)
+                               : ihs::eval::ReportScan(object, seen, mesh, gt, trajectory));
   if (!json_path.empty()) ihs::WriteFileAtomically(json_path, out.dump(1) + "\n");
   return ihs::kExitOk;
 }
@@ -70,12 +72,17 @@ int main(int argc, char** argv) {
       "inhandscan-measure"};
   app.footer(ihs::ExitCodesHelp());
   app.set_version_flag("--version", std::string("inhandscan-measure ") + IHS_VERSION);
-  std::string mesh, object, gt, trajectory, json, log_level = "info";
+  std::string mesh, seen, object, gt, trajectory, json, log_level = "info";
   bool quiet = false;
   app.add_option("mesh", mesh, "the scanned mesh (PLY, OBJ, STL)")->required();
   app.add_option("--object", object,
                  "what was scanned: sphere, water-bottle, bowling-pin, small-bottle or "
                  "lathe:FILE (the paper's measures against its true dimensions)");
+  app.add_option("--seen", seen,
+                 "the seen surface of a scan whose MESH is watertight (mesh_tsdf.ply beside "
+                 "mesh.ply): the dimensions and the surface errors are measured on it, the volume "
+                 "on MESH with the share of MESH that was never seen")
+      ->check(CLI::ExistingFile);
   app.add_option("--gt", gt, "a generator's gt/ folder (needs the scan's trajectory)");
   app.add_option("--trajectory", trajectory,
                  "the scan's TUM trajectory (default: trajectory.txt beside the mesh)");
@@ -85,6 +92,6 @@ int main(int argc, char** argv) {
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-measure", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
-    return Run(mesh, object, gt, trajectory, json);
+    return Run(mesh, seen, object, gt, trajectory, json);
   });
 }

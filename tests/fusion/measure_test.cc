@@ -165,6 +165,33 @@ TEST(MeasureTest, SurfaceComparisonMeasuresTheGapAndTheCoverage) {
   EXPECT_LT(partial.scan_to_truth_mm, 0.2);
 }
 
+TEST(MeasureTest, UnseenShareIsTheClosedAreaFarFromTheSeenSurface) {
+  const TriangleMesh closed = test::MakeUvSphere(35, 128, 256);
+  // Seen: the sphere above a plane z = h; the unseen cap below it has area 2πR(R + h).
+  const auto above = [&](float h) {
+    TriangleMesh seen = closed;
+    seen.faces.clear();
+    for (const auto& f : closed.faces) {
+      if (closed.vertices[f[0]].z() > h && closed.vertices[f[1]].z() > h &&
+          closed.vertices[f[2]].z() > h) {
+        seen.faces.push_back(f);
+      }
+    }
+    return seen;
+  };
+  EXPECT_LT(UnseenShare(closed, closed), 0.001);
+  // The 2 mm band next to the seen rim counts as seen: the unseen share is the cap below
+  // z = h - 2 (for a rim on the equator, (35 - 2) / 70).
+  EXPECT_NEAR(UnseenShare(closed, above(0)), 33.0 / 70, 0.02);
+  EXPECT_NEAR(UnseenShare(closed, above(20)), (35.0 + 18) / 70, 0.02);
+  EXPECT_NEAR(UnseenShare(closed, above(0), 0.5), 34.5 / 70, 0.02);
+  // A seen surface 3 mm off the closed one everywhere: nothing of it counts as seen.
+  EXPECT_GT(UnseenShare(closed, test::MakeUvSphere(38, 64, 128)), 0.999);
+  EXPECT_DOUBLE_EQ(UnseenShare(closed, TriangleMesh{}), 1.0);
+  EXPECT_DOUBLE_EQ(UnseenShare(TriangleMesh{}, closed), 0.0);
+  EXPECT_THROW(UnseenShare(closed, closed, 0.0), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace ihs::fusion
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "core/mesh_io.h"
@@ -33,6 +34,41 @@ TEST(MeasureToolTest, ABowlingPinMeasuresToThePapersDimensions) {
   EXPECT_NEAR(json["volume_error"].get<double>(), 0.0, 0.002);
 }
 
+TEST(MeasureToolTest, AWatertightMeshWithItsSeenSurfaceSaysHowMuchOfItWasNeverSeen) {
+  test::TempDir dir;
+  const TriangleMesh ball =
+      synth::MakeLatheMesh(synth::ResampleProfile(synth::PaperObjectProfile("sphere"), 0.5), 256);
+  float low = ball.vertices.front().z(), high = low;
+  for (const auto& v : ball.vertices) low = std::min(low, v.z()), high = std::max(high, v.z());
+  TriangleMesh top = ball;  // Seen: the half above the equator.
+  top.faces.clear();
+  const float equator = 0.5f * (low + high);
+  for (const auto& f : ball.faces) {
+    if (ball.vertices[f[0]].z() > equator && ball.vertices[f[1]].z() > equator &&
+        ball.vertices[f[2]].z() > equator) {
+      top.faces.push_back(f);
+    }
+  }
+  WriteMesh(dir / "mesh.ply", ball);
+  WriteMesh(dir / "mesh_tsdf.ply", top);
+  const auto run =
+      RunTool((dir / "mesh.ply").string() + " --seen " + (dir / "mesh_tsdf.ply").string() +
+              " --object sphere --json " + (dir / "m.json").string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("never seen"), std::string::npos) << run.out;
+  const auto json = nlohmann::json::parse(test::ReadFileString(dir / "m.json"));
+  EXPECT_NEAR(json["volume_error"].get<double>(), 0.0, 0.002);
+  // The lower half less the 2 mm band under the seen rim: (35 - 2) / 70 of the sphere's area.
+  EXPECT_NEAR(json["volume_unseen_share"].get<double>(), 33.0 / 70, 0.02);
+
+  // The watertight mesh alone cannot tell what was seen: no share.
+  const auto alone = RunTool((dir / "mesh.ply").string() + " --object sphere --json " +
+                             (dir / "alone.json").string());
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  EXPECT_FALSE(nlohmann::json::parse(test::ReadFileString(dir / "alone.json"))
+                   .contains("volume_unseen_share"));
+}
+
 TEST(MeasureToolTest, BadInputGetsOneLineErrors) {
   test::TempDir dir;
   const auto missing = RunTool((dir / "none.ply").string());
@@ -42,6 +78,10 @@ TEST(MeasureToolTest, BadInputGetsOneLineErrors) {
   const auto unknown = RunTool((dir / "ball.ply").string() + " --object teapot");
   EXPECT_EQ(unknown.exit_code, 2) << unknown.err;
   EXPECT_NE(unknown.err.find("teapot"), std::string::npos);
+  const auto no_seen =
+      RunTool((dir / "ball.ply").string() + " --seen " + (dir / "none.ply").string());
+  EXPECT_EQ(no_seen.exit_code, 2) << no_seen.err;
+  EXPECT_EQ(std::count(no_seen.err.begin(), no_seen.err.end(), '\n'), 1) << no_seen.err;
 }
 
 }  // namespace
