@@ -17,6 +17,7 @@
 #include "core/check.h"
 #include "core/point_kd_tree.h"
 #include "core/stopwatch.h"
+#include "fusion/measure.h"
 
 namespace ihs::fusion {
 namespace {
@@ -297,6 +298,7 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options)
         PoissonReconstruct(result.smoothed, options.poisson_depth, options.poisson_samples_per_node,
                            options.poisson_scale, options.color),
         options.min_component_fraction);
+    result.unseen_share = UnseenShare(result.watertight, result.smoothed);
     result.poisson_ms = MillisecondsSince(start);
   }
   return result;

@@ -66,6 +66,9 @@ struct MeshingResult {
   TriangleMesh smoothed;
   /// Watertight (Poisson); empty when Poisson is off or had too few points.
   TriangleMesh watertight;
+  /// Share of `watertight`'s surface farther than 2 mm from `smoothed`: what no frame saw and
+  /// Poisson made up (UnseenShare); its volume is a guess over that part. 0 without `watertight`.
+  double unseen_share = 0;
   /// Time spent, ms.
   double cleanup_ms = 0;
   double smoothing_ms = 0;

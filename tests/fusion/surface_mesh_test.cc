@@ -123,6 +123,12 @@ TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
     near += std::abs(v.norm() - 35) < 0.5;
   }
   EXPECT_GT(near, 0.98 * counted);
+
+  // The export says how much of its watertight mesh is made up: the cap above z = 25 mm less the
+  // 2 mm band along the rim, (35 - 27) / 70 of the sphere (a little more: the cut runs below 25).
+  const MeshingResult meshes = MakeMeshes(open);
+  ASSERT_TRUE(meshes.watertight.IsWatertight());
+  EXPECT_NEAR(meshes.unseen_share, 8.0 / 70, 0.04);
 }
 
 TEST(SurfaceMeshTest, ATsdfSphereGivesAWatertightMeshOfItsSize) {
@@ -139,11 +145,14 @@ TEST(SurfaceMeshTest, ATsdfSphereGivesAWatertightMeshOfItsSize) {
   EXPECT_LT(spread, 0.5);
   const double volume_true = 4.0 / 3.0 * M_PI * 35 * 35 * 35;
   EXPECT_NEAR(meshes.watertight.Volume() / volume_true, 1.0, 0.02);
+  EXPECT_LT(meshes.unseen_share, 0.01);  // Seen from all around.
   EXPECT_TRUE(meshes.watertight.HasColors());
   EXPECT_NEAR(RadiusStats(meshes.smoothed).first, 35.0, 0.5);
-  std::printf("poisson: %zu faces, radius %.3f ± %.3f mm, %.0f ms (cleanup %.0f, smoothing %.0f)\n",
-              meshes.watertight.faces.size(), radius, spread, meshes.poisson_ms, meshes.cleanup_ms,
-              meshes.smoothing_ms);
+  std::printf(
+      "poisson: %zu faces, radius %.3f ± %.3f mm, %.0f ms (cleanup %.0f, smoothing %.0f), unseen "
+      "%.4f\n",
+      meshes.watertight.faces.size(), radius, spread, meshes.poisson_ms, meshes.cleanup_ms,
+      meshes.smoothing_ms, meshes.unseen_share);
 }
 
 // A box of half-extents `half` whose x > 0 half is red and whose x < 0 half is blue: each face
