@@ -21,7 +21,7 @@ namespace ihs::app {
 namespace {
 
 // An export whose watertight mesh is more than this share made up (never seen) warns the user:
-// the volume of a sphere seen in half moves by ±20 % with Poisson's settings alone.
+// the volume of a sphere seen in half moves by 20 % and more with Poisson's settings alone.
 constexpr double kUnseenShareWarning = 0.2;
 
 using PacketPtr = std::unique_ptr<FramePacket>;

@@ -240,12 +240,12 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
     print("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
     if (watertight.IsWatertight()) {
       const double truth = TrueVolume(object), volume = watertight.Volume();
-      // What no frame saw, Poisson closed: the volume is a guess over that part.
       print("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%", truth, volume,
             100 * (volume / truth - 1));
       report["volume_mm3"] = {{"truth", truth}, {"scan", volume}};
       report["volume_error"] = volume / truth - 1;
       if (&seen != &watertight) {
+        // What no frame saw, Poisson closed: the volume is a guess over that part.
         const double unseen = fusion::UnseenShare(watertight, seen);
         print(" (%.0f %% of its surface never seen)", 100 * unseen);
         report["volume_unseen_share"] = unseen;

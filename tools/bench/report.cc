@@ -224,11 +224,10 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
   }
   md << "## Table 1: dimensions (mm; scan and its error)\n\n" << table1.Markdown() << "\n";
   if (sphere_volume) {
-    md << "Sphere volume: the watertight mesh against the true sphere's; in brackets the share of "
-          "the watertight surface farther than 2 mm from the seen one, which Poisson made up. "
-          "Where "
-          "it is large the volume is a guess (docs/fusion.md: on half-seen spheres it moves from "
-          "+26 % to −20 % with the size of Poisson's cube alone).\n\n";
+    md << "Sphere volume: the watertight mesh against the true sphere's; in brackets the share "
+          "of the watertight surface farther than 2 mm from the seen one, which Poisson made up. "
+          "Where that share is large the volume is a guess (docs/fusion.md: on half-seen spheres "
+          "it moves from +26 % to −20 % with the size of Poisson's cube alone).\n\n";
   }
 
   // Table 2 and the other per-case measures.
