@@ -219,7 +219,8 @@ fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const Triangl
 
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const fs::path& gt_dir,
-                          const std::vector<StampedPose>& trajectory, std::FILE* out) {
+                          const std::vector<StampedPose>& trajectory,
+                          std::optional<double> unseen_share, std::FILE* out) {
   // Prints to `out` unless it is null.
   auto print = [out](const char* format, auto... values) {
     if (out) std::fprintf(out, format, values...);
@@ -244,11 +245,10 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
             100 * (volume / truth - 1));
       report["volume_mm3"] = {{"truth", truth}, {"scan", volume}};
       report["volume_error"] = volume / truth - 1;
-      if (&seen != &watertight) {
+      if (unseen_share) {
         // What no frame saw, Poisson closed: the volume is a guess over that part.
-        const double unseen = fusion::UnseenShare(watertight, seen);
-        print(" (%.0f %% of its surface never seen)", 100 * unseen);
-        report["volume_unseen_share"] = unseen;
+        print(" (%.0f %% of its surface never seen)", 100 * *unseen_share);
+        report["volume_unseen_share"] = *unseen_share;
       }
       print("\n");
     }

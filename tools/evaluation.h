@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,12 +81,13 @@ TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
 /// "dimension_error_mm_mean") and, when `watertight` is, its volume against the truth
 /// ("volume_mm3", "volume_error"); with `gt_dir` the pairwise registration error at the
 /// fingertips, the trajectory's drift and `seen` against the true surface ("pairwise_error_mm",
-/// "trajectory_error_mm", "chamfer_mm", "completeness"), `seen` placed by `trajectory`. When
-/// `seen` and `watertight` are two meshes (not one object passed twice), the volume comes with
-/// the share of the watertight surface that was never seen ("volume_unseen_share").
+/// "trajectory_error_mm", "chamfer_mm", "completeness"), `seen` placed by `trajectory`. With
+/// `unseen_share` (the share of `watertight`'s surface no frame saw: fusion::UnseenShare, which
+/// every export computes) the volume comes with it ("volume_unseen_share").
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const std::filesystem::path& gt_dir,
-                          const std::vector<StampedPose>& trajectory, std::FILE* out = stdout);
+                          const std::vector<StampedPose>& trajectory,
+                          std::optional<double> unseen_share, std::FILE* out = stdout);
 
 /// The pose of `trajectory` stamped `time_s` (within half a millisecond), or nullptr.
 const StampedPose* FindPose(const std::vector<StampedPose>& trajectory, double time_s);

@@ -57,8 +57,13 @@ int Run(const std::string& mesh_path, const std::string& seen_path, const std::s
     }
     trajectory = ihs::ReadTumTrajectory(trajectory_path);
   }
-  out.update(seen_path.empty() ? ihs::eval::ReportScan(object, mesh, mesh, gt, trajectory)
-                               : ihs::eval::ReportScan(object, seen, mesh, gt, trajectory));
+  if (seen_path.empty()) {
+    out.update(ihs::eval::ReportScan(object, mesh, mesh, gt, trajectory, std::nullopt));
+  } else {
+    // The volume on the watertight mesh, with the share of it the seen surface does not cover.
+    out.update(ihs::eval::ReportScan(object, seen, mesh, gt, trajectory,
+                                     ihs::fusion::UnseenShare(mesh, seen)));
+  }
   if (!json_path.empty()) ihs::WriteFileAtomically(json_path, out.dump(1) + "\n");
   return ihs::kExitOk;
 }

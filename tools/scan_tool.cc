@@ -168,8 +168,9 @@ int Run(const Args& args) {
     // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's
     // closing of what was never seen (a base under the hand) is guesswork that would add to a
     // bottle's height. The volume needs the watertight mesh.
-    extra["evaluation"] = ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed,
-                                                meshes.watertight, args.gt, record.trajectory());
+    extra["evaluation"] =
+        ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed, meshes.watertight,
+                              args.gt, record.trajectory(), meshes.unseen_share);
   }
   record.WriteStats(out / "stats.json", extra);
   return ihs::kExitOk;

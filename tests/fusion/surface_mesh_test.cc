@@ -124,11 +124,18 @@ TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
   }
   EXPECT_GT(near, 0.98 * counted);
 
-  // The export says how much of its watertight mesh is made up: the cap above z = 25 mm less the
-  // 2 mm band along the rim, (35 - 27) / 70 of the sphere (a little more: the cut runs below 25).
+  // The export says how much of its watertight mesh is made up: the cap beyond the seen rim (the
+  // smoothed surface's highest point, a little below 25 mm) less the 2 mm band along it.
   const MeshingResult meshes = MakeMeshes(open);
   ASSERT_TRUE(meshes.watertight.IsWatertight());
-  EXPECT_NEAR(meshes.unseen_share, 8.0 / 70, 0.04);
+  float rim_z = -35;
+  for (const auto& v : meshes.smoothed.vertices) rim_z = std::max(rim_z, v.z());
+  ASSERT_GT(rim_z, 22);
+  ASSERT_LT(rim_z, 25);
+  // Polar angle where the band ends (2 mm along the sphere from the rim); a cap's share of a
+  // sphere's area is (1 - cos θ) / 2.
+  const double band_end = std::acos(rim_z / 35.0) - 2.0 / 35;
+  EXPECT_NEAR(meshes.unseen_share, (1 - std::cos(band_end)) / 2, 0.01);
 }
 
 TEST(SurfaceMeshTest, ATsdfSphereGivesAWatertightMeshOfItsSize) {
