@@ -119,7 +119,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--case", args.cases,
                  "only these cases (001-water-bottle, 002-bowling-pin, 003-small-bottle, "
-                 "004-sphere, sphere-turn, bowling-pin-turn, textured-box-turn)");
+                 "004-sphere, 004-sphere-whole, sphere-turn, bowling-pin-turn, "
+                 "textured-box-turn)");
   app.add_flag("--quick", args.quick,
                "a few short sequences (40 frames: a recorded sphere when --data is given, a "
                "scripted sphere, the textured box), for CI");

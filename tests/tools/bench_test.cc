@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
 #include "tests/test_util.h"
+#include "tools/bench/bench_run.h"
 #include "tools/bench/open3d_baseline.h"
 #include "tools/bench/plot.h"
 
@@ -167,6 +168,35 @@ TEST(Open3dBaselineTest, AFrameWithNothingLeftIsCountedNotIntegrated) {
   EXPECT_EQ(result.empty_frames, 1);
   EXPECT_TRUE(result.trajectory.empty());
   EXPECT_TRUE(result.raw.faces.empty());
+}
+
+// Sessions cut to a number of frames leave half the sphere unseen, so the sphere's whole session
+// comes as a case of its own for the volume; uncut sessions are whole already.
+TEST(BenchCasesTest, CutSessionsComeWithTheSpheresWholeSession) {
+  auto names = [](const std::vector<BenchCase>& cases) {
+    std::vector<std::string> out;
+    for (const BenchCase& c : cases) out.push_back(c.name);
+    return out;
+  };
+  const std::vector<BenchCase> cut = DefaultCases("/data", 300);
+  const auto whole = std::find_if(cut.begin(), cut.end(),
+                                  [](const BenchCase& c) { return c.name == "004-sphere-whole"; });
+  ASSERT_NE(whole, cut.end());
+  EXPECT_EQ(whole->object, "sphere");
+  EXPECT_EQ(whole->frames, 0);
+  EXPECT_FALSE(whole->paper);  // The paper sessions' means stay over the cut sessions.
+  EXPECT_EQ(whole->motion, "recorded:/data/sequences/004-sphere");
+  for (const BenchCase& c : cut) {
+    if (c.paper) {
+      EXPECT_EQ(c.frames, 300) << c.name;
+    }
+  }
+  const std::vector<std::string> uncut = names(DefaultCases("/data", 0));
+  EXPECT_EQ(std::count(uncut.begin(), uncut.end(), "004-sphere-whole"), 0);
+  EXPECT_EQ(std::count(uncut.begin(), uncut.end(), "004-sphere"), 1);
+  // Without the hand data only the scripted cases.
+  EXPECT_EQ(names(DefaultCases("", 300)),
+            (std::vector<std::string>{"sphere-turn", "bowling-pin-turn", "textured-box-turn"}));
 }
 
 // The whole report on the quick cases: every file, every case × method, numbers that mean the

@@ -51,7 +51,8 @@ std::vector<Method> DefaultMethods(const std::vector<double>& sweep);
 
 /// The paper's four sessions (object × its recorded motion; `data`: the hand data folder with
 /// sequences/), scripted full turns of the sphere and the bowling pin, and a textured box.
-/// `frames`: cap per case (0: whole). Without `data` only the scripted cases.
+/// `frames`: cap per case (0: whole); when it cuts the sessions, the sphere's whole session is a
+/// case of its own ("004-sphere-whole", for the volume). Without `data` only the scripted cases.
 std::vector<BenchCase> DefaultCases(const std::filesystem::path& data, int frames);
 
 /// One method's result on one case.

@@ -159,8 +159,9 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
   md << "| case | object | motion | frames |\n|---|---|---|---:|\n";
   for (const CaseResult& r : results) {
     const BenchCase& c = r.bench_case;
-    const std::string motion =
-        c.motion.rfind("recorded:", 0) == 0 ? "recorded (paper session)" : "scripted full turn";
+    const std::string motion = c.motion.rfind("recorded:", 0) != 0 ? "scripted full turn"
+                               : c.frames == 0 ? "recorded (whole paper session)"
+                                               : "recorded (paper session)";
     md << "| " << c.name << " | " << c.object << (c.textured ? " (textured)" : "") << " | "
        << motion << " | " << (r.methods.empty() ? 0 : r.methods.front().frames) << " |\n";
   }
@@ -227,7 +228,9 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
     md << "Sphere volume: the watertight mesh against the true sphere's; in brackets the share "
           "of the watertight surface farther than 2 mm from the seen one, which Poisson made up. "
           "Where that share is large the volume is a guess (docs/fusion.md: on half-seen spheres "
-          "it moves from +26 % to −20 % with the size of Poisson's cube alone).\n\n";
+          "it moves from +26 % to −20 % with the size of Poisson's cube alone); a scan that saw "
+          "the whole sphere (004-sphere-whole, when it is run) is where the volume is "
+          "measured.\n\n";
   }
 
   // Table 2 and the other per-case measures.
