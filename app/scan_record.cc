@@ -131,8 +131,7 @@ nlohmann::json ScanRecord::Summary() const {
 
 void ScanRecord::WriteTables(const std::filesystem::path& folder) const {
   WriteTumTrajectory(folder / "trajectory.txt", trajectory_,
-                     {"cam_from_object of the scanned object (mm), registered frames only",
-                      "timestamp tx ty tz qx qy qz qw"});
+                     {"cam_from_object of the scanned object (mm), registered frames only"});
   tracker::WriteHandJointsCsv(folder / "hand_joints.csv", bone_names_, joints_);
   std::string poses =
       "# hand pose per tracked frame: cam_from_root (mm; quaternion x y z w), then the joint "

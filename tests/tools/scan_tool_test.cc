@@ -42,6 +42,13 @@ TEST(ScanToolTest, AShortSequenceOfASphereScansToItsSize) {
   EXPECT_NEAR(mesh.Volume() / (4.0 / 3.0 * M_PI * 35 * 35 * 35), 1.0, 0.05);
 
   const auto trajectory = ReadTumTrajectory(dir / "out" / "trajectory.txt");
+  // TUM: what it is, the column names once, then a pose per registered frame.
+  const std::string trajectory_text = test::ReadFileString(dir / "out" / "trajectory.txt");
+  const std::string header =
+      "# cam_from_object of the scanned object (mm), registered frames only\n"
+      "# timestamp tx ty tz qx qy qz qw\n";
+  EXPECT_EQ(trajectory_text.compare(0, header.size(), header), 0) << trajectory_text.substr(0, 200);
+  EXPECT_EQ(std::count(trajectory_text.begin(), trajectory_text.end(), '#'), 2);
   const auto stats = nlohmann::json::parse(test::ReadFileString(dir / "out" / "stats.json"));
   EXPECT_EQ(stats["summary"]["frames"], 90);
   EXPECT_EQ(stats["frames"].size(), 90u);
