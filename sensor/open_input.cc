@@ -26,7 +26,6 @@ class AutoOniSource : public FrameSource {
     }
     OpenNiOptions options;
     options.uri = path_;
-    options.pacing = pacing_;
     auto openni = std::make_unique<OpenNiSource>(options);
     try {
       openni->Start();
@@ -35,7 +34,7 @@ class AutoOniSource : public FrameSource {
       openni.reset();
     }
     if (openni && openni->FrameCount()) {
-      active_ = std::move(openni);
+      active_ = WithPacing(std::move(openni), pacing_);
       return;
     }
     if (openni) {
@@ -83,8 +82,7 @@ std::unique_ptr<FrameSource> OpenInput(const std::string& input, const InputOpti
     case OniBackend::kOpenNi: {
       OpenNiOptions openni;
       openni.uri = input;
-      openni.pacing = options.pacing;
-      return std::make_unique<OpenNiSource>(openni);
+      return WithPacing(std::make_unique<OpenNiSource>(openni), options.pacing);
     }
     case OniBackend::kOwnReader:
       return WithPacing(std::make_unique<OniFileSource>(input), options.pacing);

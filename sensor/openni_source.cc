@@ -207,8 +207,10 @@ void OpenNiSource::Start() {
   if (impl->is_file) {
     openni::PlaybackControl* playback = impl->device.getPlaybackControl();
     // Speed −1 makes OpenNI2's player deliver the next frame only when we wait for one, so no
-    // frame is ever skipped; 1.0 plays at the recorded pace.
-    playback->setSpeed(options_.pacing == Pacing::kRealTime ? 1.0f : -1.0f);
+    // frame is ever skipped. Never its own pacing (1.0): its thread then delivers on its own
+    // clock, and stopping the streams while it does crashed OpenNI2 under load (a replay
+    // stopped by Ctrl-C, about one in 20). The recorded pace is PacedSource's (WithPacing).
+    playback->setSpeed(-1.0f);
     playback->setRepeatEnabled(false);
     impl->depth_frame_count = playback->getNumberOfFrames(impl->depth);
   } else {

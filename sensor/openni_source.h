@@ -29,8 +29,6 @@ struct OpenNiOptions {
   bool register_depth_to_color = true;
   /// Mirror the images (off: the camera's true view, as the paper's data).
   bool mirror = false;
-  /// Recordings: as fast as the reader asks (OpenNI2 speed −1) or at the recorded pace (1.0).
-  Pacing pacing = Pacing::kAsFastAsPossible;
   /// Largest depth/colour timestamp difference for a pair, µs; a depth frame without a colour
   /// frame that close is delivered without colour.
   std::int64_t max_color_offset_us = 34'000;
