@@ -1,5 +1,6 @@
 #include "tools/evaluation.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,11 @@ namespace ihs::eval {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The angle of a rotation, degrees.
+double AngleDeg(const Eigen::Matrix3d& rotation) {
+  return Eigen::AngleAxisd(rotation).angle() * 180.0 / M_PI;
+}
 
 synth::LatheProfile ProfileOf(const std::string& spec) {
   if (spec.rfind("lathe:", 0) == 0) return synth::ReadLatheProfile(spec.substr(6));
@@ -178,7 +184,9 @@ TrajectoryError CompareTrajectory(const fs::path& gt_dir,
   if (!first) return result;
   // Scan object frame ← true object frame, fixed by the first registered frame.
   const Rigid3 scan_from_truth = trajectory.front().transform.Inverse() * first->transform;
-  double sum = 0;
+  double sum = 0, rotation_sum = 0;
+  const StampedPose* last_true = nullptr;
+  Rigid3 last_estimated;
   for (const StampedPose& pose : trajectory) {
     const StampedPose* true_pose = FindPose(truth, pose.time_s);
     if (!true_pose) continue;
@@ -192,11 +200,29 @@ TrajectoryError CompareTrajectory(const fs::path& gt_dir,
     sum += error;
     result.max_mm = std::max(result.max_mm, error);
     result.final_mm = error;
+    const double turned_off =
+        AngleDeg(estimated.rotation().transpose() * true_pose->transform.rotation());
+    rotation_sum += turned_off;
+    result.rotation_max_deg = std::max(result.rotation_max_deg, turned_off);
+    result.rotation_final_deg = turned_off;
+    if (last_true) {
+      // The steps in the object's frame (a turn of the object about its own axis).
+      const Eigen::AngleAxisd true_step(last_true->transform.rotation().transpose() *
+                                        true_pose->transform.rotation());
+      const Eigen::AngleAxisd scan_step(last_estimated.rotation().transpose() *
+                                        estimated.rotation());
+      result.truth_turned_deg += true_step.angle() * 180.0 / M_PI;
+      result.scan_turned_deg +=
+          scan_step.angle() * scan_step.axis().dot(true_step.axis()) * 180.0 / M_PI;
+    }
+    last_true = true_pose;
+    last_estimated = estimated;
     result.times_s.push_back(pose.time_s);
     result.errors_mm.push_back(error);
     ++result.frames;
   }
   result.mean_mm = result.frames ? sum / result.frames : 0;
+  result.rotation_mean_deg = result.frames ? rotation_sum / result.frames : 0;
   return result;
 }
 
@@ -264,8 +290,17 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
     const TrajectoryError drift = CompareTrajectory(gt_dir, trajectory);
     print("object trajectory error: %.2f mm mean, %.2f mm max, %.2f mm at the end\n", drift.mean_mm,
           drift.max_mm, drift.final_mm);
+    print(
+        "object rotation error: %.2f° mean, %.2f° max, %.2f° at the end; turned %.1f° of the "
+        "truth's %.1f°\n",
+        drift.rotation_mean_deg, drift.rotation_max_deg, drift.rotation_final_deg,
+        drift.scan_turned_deg, drift.truth_turned_deg);
     report["trajectory_error_mm"] = {
         {"mean", drift.mean_mm}, {"max", drift.max_mm}, {"final", drift.final_mm}};
+    report["rotation_error_deg"] = {{"mean", drift.rotation_mean_deg},
+                                    {"max", drift.rotation_max_deg},
+                                    {"final", drift.rotation_final_deg}};
+    report["turned_deg"] = {{"truth", drift.truth_turned_deg}, {"scan", drift.scan_turned_deg}};
     const fusion::SurfaceComparison surface = CompareWithTruth(gt_dir, seen, trajectory);
     print(
         "surface: Chamfer %.2f mm (scan→truth %.2f, truth→scan %.2f), completeness %.1f %% "

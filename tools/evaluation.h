@@ -63,11 +63,21 @@ fusion::SurfaceComparison CompareWithTruth(const std::filesystem::path& gt_dir,
 
 /// Drift of the scan's object trajectory: at every registered frame, how far the true object's
 /// surface points are from where the scan puts them, both trajectories tied together at the
-/// first registered frame (mean over the object's vertices), mm.
+/// first registered frame (mean over the object's vertices), mm; and how far the scan's object
+/// is turned from the true one (the angle of the rotation between them, degrees).
 struct TrajectoryError {
   double mean_mm = 0;
   double max_mm = 0;
   double final_mm = 0;
+  /// The rotation error: mean, largest and at the last compared frame, degrees.
+  double rotation_mean_deg = 0;
+  double rotation_max_deg = 0;
+  double rotation_final_deg = 0;
+  /// How far the object turned over the compared frames, the angles of the steps between
+  /// consecutive compared frames summed (a full turn about one axis: 360), degrees: the truth's,
+  /// and the scan's along the truth's step axes (a scan that follows none of the turn: 0).
+  double truth_turned_deg = 0;
+  double scan_turned_deg = 0;
   int frames = 0;
   /// Per compared frame: its time stamp (s) and its error (mm).
   std::vector<double> times_s, errors_mm;

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "core/mesh_io.h"
@@ -62,6 +63,37 @@ TEST_F(EvaluationTest, TheTrueTrajectoryHasNoErrorAndAKnownSlipIsMeasured) {
     EXPECT_NEAR(CompareTrajectory(Gt(), slipped).mean_mm, 2.0 / slipped.size(), 1e-6);
   }
   EXPECT_GT(checked, 5);
+}
+
+TEST_F(EvaluationTest, TheRotationErrorAndTheTurnFollowedAreMeasured) {
+  const auto truth = ReadTumTrajectory(Gt() / "trajectory.txt");
+  const TrajectoryError exact = CompareTrajectory(Gt(), truth);
+  EXPECT_LT(exact.rotation_max_deg, 1e-4);
+  ASSERT_GT(exact.truth_turned_deg, 5.0);  // The scripted grasp turns the ball.
+  EXPECT_NEAR(exact.scan_turned_deg, exact.truth_turned_deg, 1e-4);
+
+  // A scan that holds the object still in its first pose: the error is the truth's own turn
+  // since then, and it follows none of the turn.
+  std::vector<StampedPose> still = truth;
+  for (auto& pose : still) pose.transform = truth.front().transform;
+  const TrajectoryError held = CompareTrajectory(Gt(), still);
+  EXPECT_NEAR(held.scan_turned_deg, 0.0, 1e-6);
+  const Eigen::AngleAxisd since_first(truth.front().transform.rotation().transpose() *
+                                      truth.back().transform.rotation());
+  EXPECT_NEAR(held.rotation_final_deg, since_first.angle() * 180 / M_PI, 1e-6);
+  EXPECT_GE(held.rotation_max_deg, held.rotation_final_deg);
+
+  // One frame k alone turned by 3° about the camera's z: 3° off there, 0 elsewhere.
+  std::vector<StampedPose> turned = truth;
+  const size_t k = truth.size() / 2;
+  const Eigen::Vector3d centre = turned[k].transform.translation();
+  turned[k].transform = Rigid3::Translation(centre) *
+                        Rigid3::FromAxisAngle({0, 0, 1}, 3 * M_PI / 180) *
+                        Rigid3::Translation(-centre) * turned[k].transform;
+  const TrajectoryError one = CompareTrajectory(Gt(), turned);
+  EXPECT_NEAR(one.rotation_max_deg, 3.0, 1e-6);
+  EXPECT_NEAR(one.rotation_mean_deg, 3.0 / truth.size(), 1e-6);
+  EXPECT_NEAR(one.rotation_final_deg, 0.0, 1e-6);
 }
 
 TEST_F(EvaluationTest, TheTrueObjectMatchesItselfPlacedByTheTrajectory) {
