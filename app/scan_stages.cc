@@ -5,6 +5,7 @@
 #include "fusion/object_mask.h"
 #include "fusion/shot_matcher.h"
 #include "fusion/sift_matcher.h"
+#include "tracker/contacts.h"
 #include "tracker/hand_data.h"
 #include "tracker/hand_kinematics.h"
 
@@ -37,7 +38,10 @@ tracker::HandModel LoadHandTemplate(const ScanOptions& options) {
 HandStage::HandStage(const ScannerOptions& options, const CameraIntrinsics& intrinsics)
     : options_(Checked(options).scan),
       intrinsics_(intrinsics),
-      tracker_(LoadHandTemplate(options.scan), intrinsics, TrackerOptionsFor(options)) {}
+      tracker_(LoadHandTemplate(options.scan), intrinsics, TrackerOptionsFor(options)),
+      fingertips_(std::make_shared<const std::vector<std::vector<int>>>(
+          tracker::ContactDetector(tracker_.model(), options.tracker.contacts)
+              .fingertip_vertices())) {}
 
 HandStage::~HandStage() = default;
 
@@ -85,6 +89,7 @@ void HandStage::Process(FramePacket& packet) {
         fusion::RemoveMeshPixels(*hand, frame, intrinsics_, options_.hand_dilation_px,
                                  options_.hand_depth_margin_mm, &packet.object_mask);
     packet.hand_mesh = std::move(hand);
+    packet.fingertips = fingertips_;
   }
   packet.mask_ms = MillisecondsSince(start);
 }
@@ -123,6 +128,10 @@ void ObjectStage::Process(FramePacket& packet) {
   packet.sift_matches = static_cast<int>(input.correspondences.features_2d.size());
   packet.shot_matches = static_cast<int>(input.correspondences.features_3d.size());
   packet.contact_pairs = static_cast<int>(input.correspondences.contacts.size());
+  if (packet.hand_mesh && packet.fingertips) {
+    input.hand_vertices = &packet.hand_mesh->vertices;
+    input.fingertips = packet.fingertips.get();
+  }
   packet.fusion = fusion_.Fuse(input);
 }
 

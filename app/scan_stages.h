@@ -40,6 +40,8 @@ struct FramePacket {
   tracker::TrackResult track;
   /// The posed hand model (camera frame, mm) when the tracker has a pose.
   std::shared_ptr<const TriangleMesh> hand_mesh;
+  /// Each fingertip's vertex indices in `hand_mesh` (the same for every frame of a scan).
+  std::shared_ptr<const std::vector<std::vector<int>>> fingertips;
   /// Per pixel: non-zero where the object is, the hand model's pixels (dilated) removed.
   std::vector<std::uint8_t> object_mask;
   int hand_pixels_removed = 0;
@@ -85,6 +87,7 @@ class HandStage {
   const ScanOptions options_;
   const CameraIntrinsics intrinsics_;
   tracker::HandTracker tracker_;
+  std::shared_ptr<const std::vector<std::vector<int>>> fingertips_;
 };
 
 /// Correspondences, registration, ICP and the TSDF: the model belongs to this stage.

@@ -151,6 +151,17 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "1/disagreement^2; 0: fixed share), mm");
   r.Add("fusion.anchor_slip_mm", &u.anchor_slip_mm,
         "a contact farther than this from its anchor has slipped, mm");
+  r.Add("fusion.icp_contacts_need_spread", &u.icp_contacts_need_spread,
+        "contacts hold ICP only when spread like pairwise.min_contact_spread_mm asks (off: one "
+        "fingertip's patch holds it too, in the directions the surface leaves free)");
+  r.Add("fusion.model_contacts.enabled", &u.model_contacts.enabled,
+        "fingertips on the model's surface in the previous frame are contacts too");
+  r.Add("fusion.model_contacts.distance_mm", &u.model_contacts.distance_mm,
+        "a fingertip vertex within this of the model's surface (or inside) is on it, mm");
+  r.Add("fusion.model_contacts.min_vertex_share", &u.model_contacts.min_vertex_share,
+        "share of a fingertip's vertices on the surface that makes it a contact");
+  r.Add("fusion.model_contacts.min_fingertips", &u.model_contacts.min_fingertips,
+        "fingertips on the surface needed for any to count");
   r.Add("fusion.tsdf.size_mm", &u.tsdf.size_mm, "edge of the TSDF cube, mm (paper: 350)");
   r.Add("fusion.tsdf.resolution", &u.tsdf.resolution, "TSDF voxels per edge (paper: 256)");
   r.Add("fusion.tsdf.truncation_voxels", &u.tsdf.truncation_voxels,

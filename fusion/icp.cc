@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/check.h"
 
@@ -17,6 +18,35 @@ void IcpOptions::Check() const {
   IHS_CHECK_ARG(anchor_share >= 0, "icp.anchor_share must be >= 0");
   IHS_CHECK_ARG(min_constraint_over_noise >= 0, "icp.min_constraint_over_noise must be >= 0");
 }
+
+namespace {
+
+// The part of a step in the directions `free` (columns of `basis`) that best meets the anchors
+// (normal equations `anchor_matrix`·x = `anchor_rhs`) given the rest of the step, `fixed`;
+// directions the anchors hardly know (under a millionth of their strongest) stay at zero.
+Eigen::Matrix<double, 6, 1> AnchorStep(const Eigen::Matrix<double, 6, 6>& basis,
+                                       const std::vector<int>& free,
+                                       const Eigen::Matrix<double, 6, 6>& anchor_matrix,
+                                       const Eigen::Matrix<double, 6, 1>& anchor_rhs,
+                                       const Eigen::Matrix<double, 6, 1>& fixed) {
+  const int k = static_cast<int>(free.size());
+  Eigen::MatrixXd directions(6, k);
+  for (int c = 0; c < k; ++c) directions.col(c) = basis.col(free[c]);
+  const Eigen::MatrixXd reduced = directions.transpose() * anchor_matrix * directions;
+  const Eigen::VectorXd wanted = directions.transpose() * (anchor_rhs - anchor_matrix * fixed);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(reduced);
+  const double strongest = anchor_matrix.trace();
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(k);
+  for (int i = 0; i < k; ++i) {
+    const double value = eigen.eigenvalues()[i];
+    if (!(value > 1e-6 * strongest)) continue;
+    const auto direction = eigen.eigenvectors().col(i);
+    y += direction * (direction.dot(wanted) / value);
+  }
+  return directions * y;
+}
+
+}  // namespace
 
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
@@ -46,9 +76,10 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   spread_sq /= std::max<size_t>(1, points.size());
   Eigen::Vector3d pivot = centroid;
   double scale = std::max(1.0, std::sqrt(spread_sq));
-  // Without anchors, the directions the surface leaves free keep the prediction
-  // (IcpOptions::min_constraint_over_noise).
-  const bool keep_free = anchors.empty() && options.min_constraint_over_noise > 0;
+  // Without anchors (or with anchors for them alone), the directions the surface leaves free keep
+  // the prediction (IcpOptions::min_constraint_over_noise, anchors_free_directions_only).
+  const bool keep_free = (anchors.empty() || options.anchors_free_directions_only) &&
+                         options.min_constraint_over_noise > 0;
   std::vector<double> normal_jitter;
   // What a direction of the motion learns per point pair from the model's normal noise alone.
   double noise_information = 0;
@@ -138,6 +169,8 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
     for (const IcpAnchor& anchor : anchors) anchor_total += anchor.weight;
     const double anchor_scale =
         anchor_total > 0 ? options.anchor_share * std::max(inliers, 1) / anchor_total : 0.0;
+    Eigen::Matrix<double, 6, 6> anchor_matrix = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> anchor_rhs = Eigen::Matrix<double, 6, 1>::Zero();
     for (const IcpAnchor& anchor : anchors) {
       const double weight = anchor.weight * anchor_scale;
       const Eigen::Vector3d p = correction * anchor.current;
@@ -145,9 +178,13 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
       for (int k = 0; k < 3; ++k) {
         Eigen::Matrix<double, 6, 1> row;
         row << ((p - centre) / scale).cross(Eigen::Vector3d::Unit(k)), Eigen::Vector3d::Unit(k);
-        normal_matrix += weight * row * row.transpose();
-        rhs -= weight * row * residual[k];
+        anchor_matrix += weight * row * row.transpose();
+        anchor_rhs -= weight * row * residual[k];
       }
+    }
+    if (!keep_free) {
+      normal_matrix += anchor_matrix;
+      rhs += anchor_rhs;
     }
     if (inliers < 6) break;
     // A little (Marquardt) damping keeps directions the data do not constrain at all where the
@@ -156,16 +193,26 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
     normal_matrix.diagonal().array() += 1e-9;
     Eigen::Matrix<double, 6, 1> step;
     if (keep_free && noise_information > 0) {
-      // Only the directions the surface constrains move; the others keep the prediction.
+      // Only the directions the surface constrains move; the others keep the prediction, or
+      // follow the anchors where they have any.
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(normal_matrix);
       const double floor = options.min_constraint_over_noise * noise_information * inliers;
       step.setZero();
+      std::vector<int> free;
       for (int i = 0; i < 6; ++i) {
         const double value = eigen.eigenvalues()[i];
-        if (value <= floor || value <= 0) continue;
+        if (value <= floor || value <= 0) {
+          free.push_back(i);
+          continue;
+        }
         const auto direction = eigen.eigenvectors().col(i);
         step += direction * (direction.dot(rhs) / value);
       }
+      if (!free.empty() && !anchors.empty())
+        step += AnchorStep(eigen.eigenvectors(), free, anchor_matrix, anchor_rhs, step);
+    } else if (keep_free) {
+      // No measure of the normals' noise to tell free directions by: the anchors join in.
+      step = (normal_matrix + anchor_matrix).ldlt().solve(rhs + anchor_rhs);
     } else {
       step = normal_matrix.ldlt().solve(rhs);
     }

@@ -43,6 +43,12 @@ struct IcpOptions {
   /// turn a noiseless 45 x 30 x 18 mm ellipsoid's cap fixes only weakly: 1.5 is a compromise,
   /// and a weakly fixed turn then keeps the prediction. 0 solves every direction.
   double min_constraint_over_noise = 1.5;
+  /// Whether the anchors decide only the directions the surface leaves free (those the rule
+  /// above keeps at the prediction without anchors), the surface alone all the others: for
+  /// anchors that fix a point of the object but hardly its turn (one fingertip's patch), whose
+  /// pull on what the surface fixes would be noise. Where the anchors know nothing of a free
+  /// direction either, it keeps the prediction. ObjectFusion sets it per frame.
+  bool anchors_free_directions_only = false;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

@@ -27,6 +27,11 @@ void FusionOptions::Check() const {
   tsdf.Check();
   pairwise.Check();
   icp.Check();
+  model_contacts.Check();
+  IHS_CHECK_ARG(
+      !model_contacts.enabled ||
+          model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
+      "fusion.model_contacts.distance_mm must be less than the TSDF's truncation");
   IHS_CHECK_ARG(min_object_points >= 10, "fusion.min_object_points must be >= 10");
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
@@ -42,11 +47,35 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       volume_(options_.tsdf),
       contact_noise_mm_(options_.contact_noise_reference_mm) {}
 
-int ObjectFusion::ApplyAnchors(const FusionInput& input, PairwiseInput* correspondences) const {
-  if (!options_.anchor_contacts || input.contact_ids.empty()) return 0;
+int ObjectFusion::AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
+                                   std::vector<int>* contact_ids) const {
+  if (!options_.model_contacts.enabled || !input.hand_vertices || !input.fingertips ||
+      previous_hand_.empty() || !started_) {
+    return 0;
+  }
+  // Without ids the tracker's contacts cannot be told apart from the model's: none added.
+  if (contact_ids->size() != correspondences->contacts.size()) return 0;
+  const std::vector<ModelContact> found =
+      FindModelContacts(volume_, cam_from_object_.Inverse(), previous_hand_, *input.hand_vertices,
+                        *input.fingertips, options_.model_contacts);
+  std::vector<int> known = *contact_ids;
+  std::sort(known.begin(), known.end());
+  int added = 0;
+  for (const ModelContact& contact : found) {
+    if (std::binary_search(known.begin(), known.end(), contact.vertex)) continue;
+    correspondences->contacts.push_back({contact.previous, contact.current});
+    contact_ids->push_back(contact.vertex);
+    ++added;
+  }
+  return added;
+}
+
+int ObjectFusion::ApplyAnchors(const std::vector<int>& contact_ids,
+                               PairwiseInput* correspondences) const {
+  if (!options_.anchor_contacts || contact_ids.empty()) return 0;
   int anchored = 0;
   for (size_t i = 0; i < correspondences->contacts.size(); ++i) {
-    const auto found = anchors_.find(input.contact_ids[i]);
+    const auto found = anchors_.find(contact_ids[i]);
     if (found == anchors_.end()) continue;
     correspondences->contacts[i].previous = cam_from_object_ * found->second.object_point;
     ++anchored;
@@ -54,14 +83,16 @@ int ObjectFusion::ApplyAnchors(const FusionInput& input, PairwiseInput* correspo
   return anchored;
 }
 
-void ObjectFusion::UpdateAnchors(const FusionInput& input, const Rigid3& cam_from_object) {
+void ObjectFusion::UpdateAnchors(const std::vector<int>& contact_ids,
+                                 const std::vector<PointMatch>& contacts,
+                                 const Rigid3& cam_from_object) {
   std::unordered_map<int, Anchor> held;
-  if (options_.anchor_contacts && !input.contact_ids.empty()) {
+  if (options_.anchor_contacts && !contact_ids.empty()) {
     const Rigid3 object_from_cam = cam_from_object.Inverse();
-    for (size_t i = 0; i < input.contact_ids.size(); ++i) {
-      const Eigen::Vector3d seen = object_from_cam * input.correspondences.contacts[i].current;
+    for (size_t i = 0; i < contact_ids.size(); ++i) {
+      const Eigen::Vector3d seen = object_from_cam * contacts[i].current;
       Anchor anchor{seen, 1};
-      const auto found = anchors_.find(input.contact_ids[i]);
+      const auto found = anchors_.find(contact_ids[i]);
       if (found != anchors_.end() &&
           (found->second.object_point - seen).norm() <= options_.anchor_slip_mm) {
         // The running mean of where the contact has been seen.
@@ -69,7 +100,7 @@ void ObjectFusion::UpdateAnchors(const FusionInput& input, const Rigid3& cam_fro
         ++anchor.observations;
         anchor.object_point += (seen - anchor.object_point) / anchor.observations;
       }
-      held[input.contact_ids[i]] = anchor;
+      held[contact_ids[i]] = anchor;
     }
   }
   anchors_ = std::move(held);
@@ -90,6 +121,12 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   auto finish = [&](FusionStatus status, std::string reason = {}) {
     result.status = status;
     result.reason = std::move(reason);
+    // The hand of a registered frame, for the next frame's model contacts.
+    if (status != FusionStatus::kSkipped && input.hand_vertices) {
+      previous_hand_ = *input.hand_vertices;
+    } else {
+      previous_hand_.clear();
+    }
     result.milliseconds = MillisecondsSince(started_at);
     return std::move(result);
   };
@@ -130,7 +167,9 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   Rigid3 pose = cam_from_object_;
   const auto pairwise_start = SteadyClock::now();
   PairwiseInput correspondences = input.correspondences;
-  result.anchored_contacts = ApplyAnchors(input, &correspondences);
+  std::vector<int> contact_ids = input.contact_ids;
+  result.model_contacts = AddModelContacts(input, &correspondences, &contact_ids);
+  result.anchored_contacts = ApplyAnchors(contact_ids, &correspondences);
   result.pairwise = RegisterPair(correspondences, options_.pairwise);
   result.pairwise_ms = MillisecondsSince(pairwise_start);
   if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
@@ -141,11 +180,14 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
         2 * options_.icp.max_distance_mm * intrinsics_.fx / std::max(1.0, pose.translation().z())));
     const std::array<int, 4> roi = {box[0] - margin, box[1] - margin, box[2] + margin,
                                     box[3] + margin};
-    // The contacts, where the registration moved them, hold ICP where the surface cannot: only
-    // a grasp's (spread like the registration asks), not one fingertip's patch.
+    // The contacts, where the registration moved them (where it did not, where they were),
+    // hold ICP where the surface cannot (FusionOptions::icp_contacts_need_spread).
     std::vector<IcpAnchor> anchors;
-    if (result.pairwise.ok && options_.pairwise.contact_weight > 0 &&
-        result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm) {
+    const bool spread =
+        result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm;
+    if (options_.pairwise.contact_weight > 0 &&
+        static_cast<int>(correspondences.contacts.size()) >= options_.pairwise.min_contacts &&
+        (!options_.icp_contacts_need_spread || (result.pairwise.ok && spread))) {
       const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
       const double inlier_sq = options_.pairwise.inlier_mm * options_.pairwise.inlier_mm;
       for (const PointMatch& contact : correspondences.contacts) {
@@ -175,6 +217,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     const float window =
         static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
     IcpOptions icp_options = options_.icp;
+    // Contacts that fix a point but hardly a turn decide only what the surface leaves free.
+    icp_options.anchors_free_directions_only = !spread;
     if (options_.contact_noise_reference_mm > 0 && contact_noise_mm_ > 0) {
       const double ratio = options_.contact_noise_reference_mm / contact_noise_mm_;
       icp_options.anchor_share *= std::clamp(ratio * ratio, 0.01, 100.0);
@@ -242,7 +286,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const auto integrate_start = SteadyClock::now();
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
   result.integrate_ms = MillisecondsSince(integrate_start);
-  UpdateAnchors(input, pose);
+  UpdateAnchors(contact_ids, correspondences.contacts, pose);
   return finish(FusionStatus::kFused);
 }
 

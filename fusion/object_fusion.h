@@ -15,6 +15,7 @@
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 #include "fusion/icp.h"
+#include "fusion/model_contacts.h"
 #include "fusion/pairwise_registration.h"
 #include "fusion/tsdf_volume.h"
 
@@ -25,6 +26,9 @@ struct FusionOptions {
   TsdfOptions tsdf;
   PairwiseOptions pairwise;
   IcpOptions icp;
+  /// Fingertip contacts found against the model besides the tracker's (model_contacts.h);
+  /// they need FusionInput's hand vertices and fingertips.
+  ModelContactOptions model_contacts;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -51,6 +55,14 @@ struct FusionOptions {
   /// Accurate contacts then decide what the surface leaves weak; noisy ones cannot drag what it
   /// fixes. 0 keeps `icp.anchor_share` fixed.
   double contact_noise_reference_mm = 1.0;
+  /// Whether the contacts hold ICP only when they spread like the registration asks
+  /// (PairwiseOptions::min_contact_spread_mm; the paper's two contact bones). Off: contacts
+  /// that do not spread so far (one fingertip's patch, two neighbouring fingertips) hold it
+  /// too, but only in the directions the surface leaves free (IcpOptions::
+  /// anchors_free_directions_only). Alone, a 10 mm patch fixes a point of the object but
+  /// hardly its turn; with the surface, which fixes all but the turns it leaves free (a ball's,
+  /// a bottle's about its axis), the patch's shift at its distance from the axis is that turn.
+  bool icp_contacts_need_spread = false;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -67,6 +79,11 @@ struct FusionInput {
   /// For each of `correspondences.contacts`, what identifies the touching skin point from
   /// frame to frame (the hand model's vertex index); empty: contacts are not anchored.
   std::vector<int> contact_ids;
+  /// The posed hand model's vertices in this frame (camera frame, mm) and each fingertip's
+  /// vertex indices: with both, fingertips on the model's surface are contacts too
+  /// (FusionOptions::model_contacts). Null: only `correspondences.contacts`.
+  const std::vector<Eigen::Vector3f>* hand_vertices = nullptr;
+  const std::vector<std::vector<int>>* fingertips = nullptr;
 };
 
 /// What happened to a frame.
@@ -91,6 +108,9 @@ struct FusionResult {
   int integrated_voxels = 0;
   /// Contacts registered against their anchor rather than the previous frame.
   int anchored_contacts = 0;
+  /// Contact pairs found against the model that the tracker's contacts did not have (they are
+  /// part of `pairwise.contacts` when used).
+  int model_contacts = 0;
   /// The contacts' disagreement with the final pose in this frame (median distance, mm; 0
   /// without contacts), and the running estimate that weighs them in ICP (see
   /// FusionOptions::contact_noise_reference_mm).
@@ -122,11 +142,16 @@ class ObjectFusion {
   const FusionOptions& options() const { return options_; }
 
  private:
+  // Adds the fingertip contacts found against the model that `contact_ids` lacks; returns how
+  // many pairs.
+  int AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
+                       std::vector<int>* contact_ids) const;
   // Replaces the previous-frame positions of anchored contacts by their anchors (seen from the
   // previous pose); returns how many.
-  int ApplyAnchors(const FusionInput& input, PairwiseInput* correspondences) const;
+  int ApplyAnchors(const std::vector<int>& contact_ids, PairwiseInput* correspondences) const;
   // After registering at `cam_from_object`: anchors of the contacts still held, updated.
-  void UpdateAnchors(const FusionInput& input, const Rigid3& cam_from_object);
+  void UpdateAnchors(const std::vector<int>& contact_ids, const std::vector<PointMatch>& contacts,
+                     const Rigid3& cam_from_object);
 
   struct Anchor {
     Eigen::Vector3d object_point;
@@ -145,6 +170,8 @@ class ObjectFusion {
   // at the reference: the configured share until contacts have been seen).
   double contact_noise_mm_ = 0;
   std::unordered_map<int, Anchor> anchors_;
+  // The hand's vertices in the previous frame, when it was registered (else empty).
+  std::vector<Eigen::Vector3f> previous_hand_;
 };
 
 }  // namespace ihs::fusion
