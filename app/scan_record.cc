@@ -75,6 +75,7 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("integrate_ms", fused.integrate_ms);
     entry["anchored_contacts"] = fused.anchored_contacts;
     entry["model_contacts"] = fused.model_contacts;
+    entry["icp_anchors"] = fused.icp_anchors;
     entry["contact_residual_mm"] = fused.contact_residual_mm;
     entry["contact_noise_mm"] = fused.contact_noise_mm;
     entry["contact_spread_mm"] = fused.pairwise.contact_spread_mm;

@@ -234,6 +234,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
       result.icp_ms += MillisecondsSince(icp_start);
       return icp;
     };
+    result.icp_anchors = static_cast<int>(anchors.size());
     result.icp = align(pose, anchors);
     // A registration that lands far off (a bad contact, a slipped finger) leaves ICP few pairs;
     // from where the object was, it may find more.

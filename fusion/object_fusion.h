@@ -111,6 +111,10 @@ struct FusionResult {
   /// Contact pairs found against the model that the tracker's contacts did not have (they are
   /// part of `pairwise.contacts` when used).
   int model_contacts = 0;
+  /// Contacts that held ICP as anchors (FusionOptions::icp_contacts_need_spread).
+  int icp_anchors = 0;
+  /// Whether the contacts took part: in the registration or as ICP's anchors.
+  bool ContactsUsed() const { return pairwise.contacts > 0 || icp_anchors > 0; }
   /// The contacts' disagreement with the final pose in this frame (median distance, mm; 0
   /// without contacts), and the running estimate that weighs them in ICP (see
   /// FusionOptions::contact_noise_reference_mm).

@@ -5,11 +5,14 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdlib>
 
 #include "core/check.h"
 #include "core/errors.h"
 
 namespace ihs::render {
+
+void UseMachineIndependentRasteriser() { setenv("GALLIUM_DRIVER", "softpipe", /*overwrite=*/0); }
 
 void RendererOptions::Check() const {
   IHS_CHECK_ARG(near_mm > 0, "renderer.near_mm must be positive, got " << near_mm);

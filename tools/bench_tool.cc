@@ -17,6 +17,7 @@
 #include "core/errors.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
+#include "render/offscreen_renderer.h"
 #include "tools/bench/bench_run.h"
 #include "tools/bench/open3d_baseline.h"
 #include "tools/bench/report.h"
@@ -99,6 +100,7 @@ int Run(const Args& args) {
 
 int main(int argc, char** argv) {
   ihs::KeepFreedMemoryForReuse();
+  ihs::render::UseMachineIndependentRasteriser();
   CLI::App app{
       "The benchmark report: generator sequences scanned by ours and the baselines, measured "
       "against the ground truth (the paper's Table 1 and 2, joint error, Chamfer, speed, the γt "

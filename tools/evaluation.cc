@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -34,20 +35,32 @@ synth::LatheProfile ProfileOf(const std::string& spec) {
 // hand_joints.csv (the end of its last bone: "RFing.<f>_…" columns, thumb = finger 4).
 constexpr const char* kFingers[5] = {"pinky", "ring", "middle", "index", "thumb"};
 
-// Per frame of gt/contacts.csv: whether each fingertip touches the object.
-std::map<std::int64_t, std::array<bool, 5>> ReadTouches(const fs::path& path) {
+// One frame of gt/contacts.csv: whether each fingertip touches the object, and how far it is
+// from the object's surface (mm).
+struct TrueContacts {
+  std::array<bool, 5> touch{};
+  std::array<double, 5> distance_mm{};
+  bool operator[](int finger) const { return touch[finger]; }
+};
+
+// The column of `name` in `header`; throws naming `path` when there is none.
+int Column(const std::vector<std::string>& header, const std::string& name, const fs::path& path) {
+  const auto found = std::find(header.begin(), header.end(), name);
+  if (found == header.end()) throw InputError(path.string() + ": no column " + name);
+  return static_cast<int>(found - header.begin());
+}
+
+// Per frame of gt/contacts.csv: whether each fingertip touches the object, and its distance.
+std::map<std::int64_t, TrueContacts> ReadTouches(const fs::path& path) {
   const std::vector<DataLine> lines = ReadDataLines(path);
   if (lines.empty()) throw InputError(path.string() + ": empty");
   const std::vector<std::string> header = SplitFields(lines.front().text);
-  std::array<int, 5> column{};
+  std::array<int, 5> column{}, distance_column{};
   for (int f = 0; f < 5; ++f) {
-    const auto found = std::find(header.begin(), header.end(), std::string(kFingers[f]) + "_touch");
-    if (found == header.end()) {
-      throw InputError(path.string() + ": no column " + kFingers[f] + "_touch");
-    }
-    column[f] = static_cast<int>(found - header.begin());
+    column[f] = Column(header, std::string(kFingers[f]) + "_touch", path);
+    distance_column[f] = Column(header, std::string(kFingers[f]) + "_mm", path);
   }
-  std::map<std::int64_t, std::array<bool, 5>> touches;
+  std::map<std::int64_t, TrueContacts> touches;
   for (size_t i = 1; i < lines.size(); ++i) {
     const std::vector<std::string> fields = SplitFields(lines[i].text);
     if (fields.size() != header.size()) {
@@ -55,9 +68,12 @@ std::map<std::int64_t, std::array<bool, 5>> ReadTouches(const fs::path& path) {
                        std::to_string(fields.size()) + " fields, the header " +
                        std::to_string(header.size()));
     }
-    std::array<bool, 5> touch{};
-    for (int f = 0; f < 5; ++f) touch[f] = fields[column[f]] == "1";
-    touches[std::stoll(fields[0])] = touch;
+    TrueContacts contacts;
+    for (int f = 0; f < 5; ++f) {
+      contacts.touch[f] = fields[column[f]] == "1";
+      contacts.distance_mm[f] = std::stod(fields[distance_column[f]]);
+    }
+    touches[std::stoll(fields[0])] = contacts;
   }
   return touches;
 }
@@ -224,6 +240,36 @@ TrajectoryError CompareTrajectory(const fs::path& gt_dir,
   result.mean_mm = result.frames ? sum / result.frames : 0;
   result.rotation_mean_deg = result.frames ? rotation_sum / result.frames : 0;
   return result;
+}
+
+ContactUse CompareContactUse(const fs::path& gt_dir, const std::vector<FrameContactUse>& frames,
+                             double false_mm) {
+  const std::vector<StampedPose> truth = ReadTumTrajectory(gt_dir / "trajectory.txt");
+  const auto touches = ReadTouches(gt_dir / "contacts.csv");
+  ContactUse use;
+  for (const FrameContactUse& frame : frames) {
+    // The truth's frame index: its row in the trajectory with this time stamp.
+    const StampedPose* pose = FindPose(truth, frame.time_s);
+    if (!pose) continue;
+    const auto touch = touches.find(static_cast<std::int64_t>(pose - truth.data()));
+    if (touch == touches.end()) continue;
+    const TrueContacts& contacts = touch->second;
+    const int touching =
+        static_cast<int>(std::count(contacts.touch.begin(), contacts.touch.end(), true));
+    const double nearest =
+        *std::min_element(contacts.distance_mm.begin(), contacts.distance_mm.end());
+    if (touching >= 2) {
+      ++use.grasp_frames;
+      use.used_in_grasp += frame.used;
+    }
+    if (frame.used) {
+      ++use.used_frames;
+      use.false_frames += nearest > false_mm;
+    }
+  }
+  use.recall = use.grasp_frames ? static_cast<double>(use.used_in_grasp) / use.grasp_frames : 0;
+  use.false_share = use.used_frames ? static_cast<double>(use.false_frames) / use.used_frames : 0;
+  return use;
 }
 
 fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const TriangleMesh& scan,

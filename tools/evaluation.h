@@ -85,6 +85,27 @@ struct TrajectoryError {
 TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
                                   const std::vector<StampedPose>& trajectory);
 
+/// Whether the scan used fingertip contacts in a frame (time stamp, s): in the registration or
+/// as ICP's anchors.
+struct FrameContactUse {
+  double time_s = 0;
+  bool used = false;
+};
+
+/// The contacts against the truth (gt/contacts.csv): of the frames where the truth has at least
+/// two fingertips touching the object (a grasp), how many used contacts (recall); of the frames
+/// that used contacts, how many had no fingertip within `false_mm` of the object (false contacts).
+struct ContactUse {
+  int grasp_frames = 0;
+  int used_in_grasp = 0;
+  int used_frames = 0;
+  int false_frames = 0;
+  double recall = 0;
+  double false_share = 0;
+};
+ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
+                             const std::vector<FrameContactUse>& frames, double false_mm = 3.0);
+
 /// Prints a scan's measures as a table for people on `out` (nullptr: prints nothing) and returns
 /// them as JSON: with
 /// `object` (a paper object or lathe:FILE) the paper's dimensions measured on `seen` ("dimensions",

@@ -93,6 +93,7 @@ int Run(const Args& args) {
   if (error) throw ihs::OutputError(out.string() + ": cannot create (" + error.message() + ")");
 
   std::int64_t index = 0;
+  std::vector<ihs::eval::FrameContactUse> contact_use;
   const auto run_start = ihs::SteadyClock::now();
   while (args.max_frames <= 0 || index < args.max_frames) {
     const ihs::sensor::SourceRead read = source->Next(std::chrono::seconds(5));
@@ -107,6 +108,7 @@ int Run(const Args& args) {
     hand.Process(packet);
     object_stage.Process(packet);
     record.Add(packet);
+    contact_use.push_back({packet.frame->depth_timestamp_us * 1e-6, packet.fusion.ContactsUsed()});
     ++index;
   }
   if (index == 0) throw ihs::InputError(args.input + ": no frames");
@@ -171,6 +173,18 @@ int Run(const Args& args) {
     extra["evaluation"] =
         ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed, meshes.watertight,
                               args.gt, record.trajectory(), meshes.unseen_share);
+    const ihs::eval::ContactUse use = ihs::eval::CompareContactUse(args.gt, contact_use);
+    std::printf(
+        "contacts used in %d of %d frames where the truth grasps (%.0f %%); %d of %d frames with "
+        "contacts used had no fingertip within 3 mm (%.0f %%)\n",
+        use.used_in_grasp, use.grasp_frames, 100 * use.recall, use.false_frames, use.used_frames,
+        100 * use.false_share);
+    extra["evaluation"]["contacts"] = {{"grasp_frames", use.grasp_frames},
+                                       {"used_in_grasp", use.used_in_grasp},
+                                       {"recall", use.recall},
+                                       {"used_frames", use.used_frames},
+                                       {"false_frames", use.false_frames},
+                                       {"false_share", use.false_share}};
   }
   record.WriteStats(out / "stats.json", extra);
   return ihs::kExitOk;

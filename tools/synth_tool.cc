@@ -10,6 +10,7 @@
 #include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
+#include "render/offscreen_renderer.h"
 #include "tools/synth/sequence.h"
 
 namespace {
@@ -36,6 +37,7 @@ void ParseFrameRange(const std::string& text, int* first, int* last) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  ihs::render::UseMachineIndependentRasteriser();
   CLI::App app{"Render a synthetic in-hand scanning sequence with ground truth.",
                "inhandscan-synth"};
   app.footer(ihs::ExitCodesHelp());

@@ -228,6 +228,13 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
     for (HandPose& pose : CloudHypotheses(hand_points, confident_pose_, /*also_unturned=*/true))
       hypotheses.push_back(std::move(pose));
   }
+  // The articulation the tracker holds now, if it is another (one given to Initialise: a
+  // grasping hand is far from the rest pose's open one, and from the rest articulation alone a
+  // search after a jump mid-grasp settled 122 mm off with 88 % of the points explained).
+  if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad)) {
+    for (HandPose& pose : CloudHypotheses(hand_points, pose_, /*also_unturned=*/true))
+      hypotheses.push_back(std::move(pose));
+  }
   HandFitResult best = initial_fitter_->Fit(hand_points, &frame, hypotheses.front());
   for (size_t k = 1; k < hypotheses.size(); ++k) {
     HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, hypotheses[k]);

@@ -6,7 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/mesh_io.h"
 #include "tests/test_util.h"
@@ -94,6 +99,55 @@ TEST_F(EvaluationTest, TheRotationErrorAndTheTurnFollowedAreMeasured) {
   EXPECT_NEAR(one.rotation_max_deg, 3.0, 1e-6);
   EXPECT_NEAR(one.rotation_mean_deg, 3.0 / truth.size(), 1e-6);
   EXPECT_NEAR(one.rotation_final_deg, 0.0, 1e-6);
+}
+
+TEST_F(EvaluationTest, ContactUseIsCountedAgainstTheTruesGraspsAndDistances) {
+  const auto truth = ReadTumTrajectory(Gt() / "trajectory.txt");
+  // The truth's own count, read here from contacts.csv: grasps (two or more fingertips
+  // touching) and frames with no fingertip within 1 mm (the fixture's fingers are within 3 mm
+  // of the ball from its first frame on; within 1 mm only once they close on it).
+  std::ifstream csv(Gt() / "contacts.csv");
+  std::string line;
+  std::getline(csv, line);
+  int grasps = 0, far = 0;
+  std::vector<bool> far_frames;
+  while (std::getline(csv, line)) {
+    std::vector<double> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
+    ASSERT_EQ(fields.size(), 13u);  // frame, held, 5 touches, 5 distances, penetration.
+    int touching = 0;
+    double nearest = 1e9;
+    for (int f = 0; f < 5; ++f)
+      touching += fields[2 + f] > 0.5, nearest = std::min(nearest, fields[7 + f]);
+    grasps += touching >= 2;
+    far += nearest > 1.0;
+    far_frames.push_back(nearest > 1.0);
+  }
+  ASSERT_EQ(far_frames.size(), truth.size());
+  ASSERT_GT(grasps, 5);
+  ASSERT_GT(far, 0);
+
+  std::vector<FrameContactUse> none, all, near_only;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    none.push_back({truth[k].time_s, false});
+    all.push_back({truth[k].time_s, true});
+    near_only.push_back({truth[k].time_s, !far_frames[k]});
+  }
+  all.push_back({truth.back().time_s + 10.0, true});  // No such frame in the truth: ignored.
+  const ContactUse unused = CompareContactUse(Gt(), none, 1.0);
+  EXPECT_EQ(unused.grasp_frames, grasps);
+  EXPECT_EQ(unused.used_in_grasp, 0);
+  EXPECT_EQ(unused.used_frames, 0);
+  EXPECT_EQ(unused.recall, 0.0);
+  const ContactUse every = CompareContactUse(Gt(), all, 1.0);
+  EXPECT_EQ(every.used_in_grasp, grasps);
+  EXPECT_EQ(every.recall, 1.0);
+  EXPECT_EQ(every.used_frames, static_cast<int>(truth.size()));
+  EXPECT_EQ(every.false_frames, far);
+  EXPECT_NEAR(every.false_share, static_cast<double>(far) / truth.size(), 1e-12);
+  EXPECT_EQ(CompareContactUse(Gt(), near_only, 1.0).false_frames, 0);
+  EXPECT_LE(CompareContactUse(Gt(), all).false_frames, far);  // 3 mm: fewer are that far.
 }
 
 TEST_F(EvaluationTest, TheTrueObjectMatchesItselfPlacedByTheTrajectory) {
