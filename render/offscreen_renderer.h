@@ -60,9 +60,9 @@ struct RenderOutput {
 /// Makes OSMesa render the same pixels on every machine: Mesa's softpipe rasteriser (plain C)
 /// instead of llvmpipe, which compiles its rasteriser for the CPU at hand and whose depth then
 /// differs in the last bits between CPUs (with AVX-512 or without), so that a generator sequence
-/// of a given seed was not the same sequence everywhere. As fast here (the generator's cost is
-/// elsewhere). Call it at the start of main, before any thread; it leaves a GALLIUM_DRIVER the
-/// user set alone. The test suite sets the same variable for its tests (tests/CMakeLists.txt).
+/// of a given seed was not the same sequence everywhere. The generator is as fast with it (its
+/// cost is elsewhere). Call it at the start of main, before any thread; it leaves a
+/// GALLIUM_DRIVER the user set alone. The test suite sets the same variable for its tests (tests/CMakeLists.txt).
 void UseMachineIndependentRasteriser();
 
 /// Renders meshes into images of the size of `intrinsics`. One renderer per thread.
