@@ -121,8 +121,10 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   auto finish = [&](FusionStatus status, std::string reason = {}) {
     result.status = status;
     result.reason = std::move(reason);
-    // The hand of a registered frame, for the next frame's model contacts.
-    if (status != FusionStatus::kSkipped && input.hand_vertices) {
+    // The hand of a registered frame, for the next frame's model contacts (kept only when they
+    // are looked for: a copy of every vertex each frame).
+    if (options_.model_contacts.enabled && status != FusionStatus::kSkipped &&
+        input.hand_vertices) {
       previous_hand_ = *input.hand_vertices;
     } else {
       previous_hand_.clear();
