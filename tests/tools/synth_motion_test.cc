@@ -2,13 +2,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <random>
 #include <set>
 
 #include "core/errors.h"
 #include "tests/test_util.h"
 #include "tools/synth/hand_object.h"
 #include "tools/synth/object_shape.h"
+#include "tools/synth/objects.h"
 #include "tools/synth/recorded_motion.h"
 #include "tools/synth/scripted_motion.h"
 #include "tracker/hand_data.h"
@@ -40,6 +44,53 @@ TEST(ObjectShapeTest, SignedDistanceOfTheSphereAndTheBox) {
   EXPECT_NEAR(bottle.SignedDistance({0, 0, 230}), 12, 1e-9);     // Above the cap.
   EXPECT_NEAR(bottle.RadiusAt(100), 36.5, 1e-9);
   EXPECT_THROW(ObjectShape::FromSpec("teapot"), std::invalid_argument);
+}
+
+// The signed distance the slow way: to every segment of the closed (r, z) outline but the axis,
+// inside by the crossings of a ray toward +r.
+double SignedDistanceOverEverySegment(const LatheProfile& profile, const Eigen::Vector3d& p) {
+  std::vector<Eigen::Vector2d> outline = {{0.0, profile.front().first}};
+  for (const auto& [z, r] : profile) outline.emplace_back(r, z);
+  outline.emplace_back(0.0, profile.back().first);
+  const Eigen::Vector2d q(p.head<2>().norm(), p.z());
+  double distance = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i + 1 < outline.size(); ++i) {
+    const Eigen::Vector2d a = outline[i], ab = outline[i + 1] - a;
+    const double s = ab.squaredNorm() > 0 ? std::clamp((q - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+                                          : 0.0;
+    distance = std::min(distance, (q - (a + s * ab)).norm());
+  }
+  bool inside = false;
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Eigen::Vector2d& a = outline[i];
+    const Eigen::Vector2d& b = outline[(i + 1) % outline.size()];
+    if ((a.y() > q.y()) != (b.y() > q.y()) &&
+        q.x() < a.x() + (q.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) {
+      inside = !inside;
+    }
+  }
+  return inside ? -distance : distance;
+}
+
+TEST(ObjectShapeTest, TheSignedDistanceIsTheNearestOfEveryProfileSegment) {
+  // The shape searches only the segments near the point's height: the same value, to the bit,
+  // as over every segment; at random points and at the profile's own heights (flat steps, ties).
+  std::vector<std::pair<std::string, LatheProfile>> profiles;
+  for (const std::string& name : PaperObjectNames()) profiles.emplace_back(name, PaperObjectProfile(name));
+  profiles.emplace_back("steps", LatheProfile{{0, 0}, {0, 20}, {10, 20}, {10, 5}, {10, 30}, {25, 30}, {25, 0}});
+  std::mt19937 rng = test::Rng();
+  for (const auto& [name, profile] : profiles) {
+    const ObjectShape shape = ObjectShape::Lathe(name, profile, {200, 200, 200}, false);
+    const double top = profile.back().first;
+    std::uniform_real_distribution<double> xy(-60, 60), z(-20, top + 20);
+    std::uniform_int_distribution<size_t> point(0, profile.size() - 1);
+    for (int k = 0; k < 3000; ++k) {
+      Eigen::Vector3d p(xy(rng), xy(rng), z(rng));
+      if (k % 3 == 0) p.z() = profile[point(rng)].first;
+      ASSERT_EQ(shape.SignedDistance(p), SignedDistanceOverEverySegment(profile, p))
+          << name << " at " << p.transpose();
+    }
+  }
 }
 
 TEST(ObjectShapeTest, ATexturedLatheObjectHasTheSameShapeInTwoColours) {

@@ -67,6 +67,7 @@ ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& prof
     shape.max_radius_mm_ = std::max(shape.max_radius_mm_, r);
   }
   shape.outline_.emplace_back(0.0, profile.back().first);
+  for (const Eigen::Vector2d& point : shape.outline_) shape.outline_z_.push_back(point.y());
   return shape;
 }
 
@@ -92,23 +93,30 @@ double ObjectShape::SignedDistance(const Eigen::Vector3d& p) const {
     return outside + inside;
   }
   // Distance to the outline in the (r, z) half-plane, skipping the segment along the axis (the
-  // last point back to the first), which is not a surface.
+  // last point back to the first), which is not a surface. The outline's heights never
+  // decrease (the profile's do not), so a segment is at least its height gap from the point:
+  // the search starts at the segment level with the point and stops each way where the gap
+  // exceeds the nearest distance found (the same minimum as over every segment; the grasp
+  // planner asks millions of times, and this was 91 % of the generator's time).
   const Eigen::Vector2d q(p.head<2>().norm(), p.z());
+  const int segments = static_cast<int>(outline_.size()) - 1;
+  const auto level = std::upper_bound(outline_z_.begin(), outline_z_.end(), q.y());
+  // The segment whose height range holds q (z_i <= q.z < z_i+1), clamped to the outline's.
+  const int at = std::clamp(static_cast<int>(level - outline_z_.begin()) - 1, 0, segments - 1);
   double distance = std::numeric_limits<double>::infinity();
+  for (int i = at; i < segments && outline_z_[i] - q.y() < distance; ++i)
+    distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
+  for (int i = at - 1; i >= 0 && q.y() - outline_z_[i + 1] < distance; --i)
+    distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
+  // Inside: a ray toward +r crosses the closed polygon once, at the segment that spans q's
+  // height (the axis segment, at r = 0, never: q's r is not negative).
   bool inside = false;
-  for (size_t i = 0; i + 1 < outline_.size(); ++i) {
+  if (level != outline_z_.begin() && level != outline_z_.end()) {
+    const int i = static_cast<int>(level - outline_z_.begin()) - 1;
     const Eigen::Vector2d& a = outline_[i];
     const Eigen::Vector2d& b = outline_[i + 1];
-    distance = std::min(distance, SegmentDistance(q, a, b));
-  }
-  // Inside test by crossings of a ray toward +r over the closed polygon (axis segment included).
-  for (size_t i = 0; i < outline_.size(); ++i) {
-    const Eigen::Vector2d& a = outline_[i];
-    const Eigen::Vector2d& b = outline_[(i + 1) % outline_.size()];
-    if ((a.y() > q.y()) != (b.y() > q.y())) {
-      const double r = a.x() + (q.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
-      if (q.x() < r) inside = !inside;
-    }
+    const double r = a.x() + (q.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
+    inside = q.x() < r;
   }
   return inside ? -distance : distance;
 }

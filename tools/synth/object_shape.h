@@ -57,6 +57,7 @@ class ObjectShape {
   Eigen::Vector3d box_size_ = Eigen::Vector3d::Zero();
   // Closed profile polygon in the (r, z) half-plane, from the bottom axis point to the top one.
   std::vector<Eigen::Vector2d> outline_;
+  std::vector<double> outline_z_;  // Its heights, which never decrease.
 };
 
 }  // namespace ihs::synth
