@@ -83,10 +83,12 @@ struct ScanArgs {
 std::string StatusLine(const ihs::app::PipelineProgress& progress) {
   char line[256];
   const double fps = progress.FramesPerSecond();
-  std::snprintf(line, sizeof(line), "%.1f fps | frames %lld fused %lld dropped %lld | hand: %s",
-                fps, static_cast<long long>(progress.processed),
+  std::snprintf(line, sizeof(line),
+                "%.1f fps | frames %lld fused %lld dropped %lld | seen %.0f %% | hand: %s", fps,
+                static_cast<long long>(progress.processed),
                 static_cast<long long>(progress.registered),
-                static_cast<long long>(progress.dropped), progress.tracking.c_str());
+                static_cast<long long>(progress.dropped), 100 * progress.coverage,
+                progress.tracking.c_str());
   return line;
 }
 
@@ -109,9 +111,9 @@ class ProgressReporter {
       }
     }
     char line[256];
-    std::snprintf(line, sizeof(line), "frames %s, %.1f fps, fused %lld, dropped %lld%s",
+    std::snprintf(line, sizeof(line), "frames %s, %.1f fps, fused %lld, dropped %lld, seen %.0f %%%s",
                   done.c_str(), fps, static_cast<long long>(progress.registered),
-                  static_cast<long long>(progress.dropped), eta.c_str());
+                  static_cast<long long>(progress.dropped), 100 * progress.coverage, eta.c_str());
     if (terminal_) {
       std::fprintf(stderr, "\r%-78s", line);
       shown_ = true;

@@ -23,6 +23,8 @@ namespace {
 // An export whose watertight mesh is more than this share made up (never seen) warns the user:
 // the volume of a sphere seen in half moves by 20 % and more with Poisson's settings alone.
 constexpr double kUnseenShareWarning = 0.2;
+// An export warns when the frames saw the object from fewer of the directions around it.
+constexpr double kCoverageWarning = 0.8;
 
 using PacketPtr = std::unique_ptr<FramePacket>;
 
@@ -113,6 +115,7 @@ struct Pipeline::Shared {
 
   std::atomic<std::int64_t> captured{0}, processed{0}, registered{0}, exports{0};
   std::atomic<double> processing_seconds{0};  // From Start() to the last frame fused.
+  std::atomic<double> coverage{0};            // fusion::FusionResult::coverage of the last frame.
   // Live drops: frames the capture queue had no room for, and queued frames the tracker passed
   // over for a newer one.
   std::atomic<std::int64_t> dropped_capture{0}, dropped_stale{0}, previews_skipped{0};
@@ -301,6 +304,7 @@ void Pipeline::FusionLoop() {
         object = std::make_unique<ObjectStage>(options_, s.intrinsics);
         record = std::make_shared<ScanRecord>(s.bone_names);
         s.registered = 0;
+        s.coverage = 0;
         previewed_at = 0;
       }
       if (export_requested_.load() && object->started() &&
@@ -312,6 +316,7 @@ void Pipeline::FusionLoop() {
       object->Process(*packet);
       packet->latency_ms = MillisecondsSince(packet->captured_at);
       record->Add(*packet);
+      s.coverage = packet->fusion.coverage;
       ++s.processed;
       s.processing_seconds = MillisecondsSince(s.start) / 1000.0;
       if (!packet->Registered()) continue;
@@ -414,14 +419,18 @@ void Pipeline::ExportLoop() {
       if (exported.files.empty()) {
         spdlog::warn("export: nothing to mesh yet");
       } else {
-        spdlog::info("exported {} ({} faces, {:.0f} % of its surface never seen, {:.1f} s)",
-                     exported.files.back().string(), exported.meshes.watertight.faces.size(),
-                     100 * exported.meshes.unseen_share, exported.milliseconds / 1000.0);
-        if (exported.meshes.unseen_share > kUnseenShareWarning) {
+        const double coverage = job->record->coverage();
+        spdlog::info(
+            "exported {} ({} faces, seen from {:.0f} % of the directions around it, {:.0f} % of "
+            "its surface never seen, {:.1f} s)",
+            exported.files.back().string(), exported.meshes.watertight.faces.size(),
+            100 * coverage, 100 * exported.meshes.unseen_share, exported.milliseconds / 1000.0);
+        if (exported.meshes.unseen_share > kUnseenShareWarning || coverage < kCoverageWarning) {
           spdlog::warn(
-              "export: {:.0f} % of the watertight mesh was never seen and is Poisson's guess "
-              "(its volume too): turn the object to show the rest",
-              100 * exported.meshes.unseen_share);
+              "export: the object was seen from {:.0f} % of the directions around it and {:.0f} "
+              "% of the watertight mesh was never seen, Poisson's guess (its volume too): turn "
+              "the object to show the rest",
+              100 * coverage, 100 * exported.meshes.unseen_share);
         }
       }
       if (final) {
@@ -453,6 +462,7 @@ PipelineProgress Pipeline::Progress() const {
   if (source_) progress.total = source_->FrameCount();
   if (started_) progress.seconds = MillisecondsSince(s.start) / 1000.0;
   progress.processing_seconds = s.processing_seconds.load();
+  progress.coverage = s.coverage.load();
   {
     std::lock_guard<std::mutex> lock(s.mutex);
     progress.tracking = s.tracking;

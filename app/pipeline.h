@@ -57,6 +57,7 @@ struct PipelineProgress {
   double seconds = 0;                 ///< Since Start().
   double processing_seconds = 0;      ///< From Start() to the last frame through both stages.
   std::string tracking;               ///< The tracker's last status ("tracked", …).
+  double coverage = 0;                ///< Share of the directions around the object seen.
 
   /// Frames through both stages per second of processing.
   double FramesPerSecond() const {

@@ -73,6 +73,8 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("raycast_ms", fused.raycast_ms);
     timing("icp_ms", fused.icp_ms);
     timing("integrate_ms", fused.integrate_ms);
+    entry["coverage"] = fused.coverage;
+    coverage_ = fused.coverage;
     entry["anchored_contacts"] = fused.anchored_contacts;
     entry["model_contacts"] = fused.model_contacts;
     entry["icp_anchors"] = fused.icp_anchors;
@@ -121,6 +123,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"track_status_counts", track_counts_},
                             {"fusion_status_counts", fusion_counts_},
                             {"skip_reasons", skip_reasons_},
+                            {"coverage", coverage_},
                             {"ms_per_frame", ms}};
   if (!latencies_ms_.empty()) {
     summary["latency_ms"] = {

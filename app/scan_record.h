@@ -30,6 +30,8 @@ class ScanRecord {
   std::int64_t registered() const { return static_cast<std::int64_t>(trajectory_.size()); }
   /// Frames skipped by the fusion stage, by the reason's kind.
   const std::map<std::string, std::int64_t>& skip_reasons() const { return skip_reasons_; }
+  /// The share of directions around the object seen so far (fusion::FusionResult::coverage).
+  double coverage() const { return coverage_; }
   /// The object's pose in each registered frame (cam_from_object, mm).
   const std::vector<StampedPose>& trajectory() const { return trajectory_; }
 
@@ -48,6 +50,7 @@ class ScanRecord {
   std::map<std::string, std::int64_t> track_counts_, fusion_counts_, skip_reasons_;
   std::map<std::string, std::pair<double, std::int64_t>> stage_ms_;  // Sum and count.
   std::vector<double> latencies_ms_;
+  double coverage_ = 0;
   std::vector<StampedPose> trajectory_;
   std::vector<tracker::HandJointsRow> joints_;
   std::vector<std::string> pose_rows_;  // hand_poses.csv lines.

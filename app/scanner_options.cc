@@ -162,6 +162,9 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "share of a fingertip's vertices on the surface that makes it a contact");
   r.Add("fusion.model_contacts.min_fingertips", &u.model_contacts.min_fingertips,
         "fingertips on the surface needed for any to count");
+  r.Add("fusion.coverage.max_incidence_deg", &u.coverage.max_incidence_deg,
+        "a surface counts as seen from a camera within this angle of its normal, degrees "
+        "(coverage)");
   r.Add("fusion.tsdf.size_mm", &u.tsdf.size_mm, "edge of the TSDF cube, mm (paper: 350)");
   r.Add("fusion.tsdf.resolution", &u.tsdf.resolution, "TSDF voxels per edge (paper: 256)");
   r.Add("fusion.tsdf.truncation_voxels", &u.tsdf.truncation_voxels,

@@ -28,6 +28,7 @@ void FusionOptions::Check() const {
   pairwise.Check();
   icp.Check();
   model_contacts.Check();
+  coverage.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -45,6 +46,7 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
     : intrinsics_(intrinsics),
       options_((options.Check(), std::move(options))),
       volume_(options_.tsdf),
+      coverage_(options_.coverage),
       contact_noise_mm_(options_.contact_noise_reference_mm) {}
 
 int ObjectFusion::AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
@@ -129,6 +131,10 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     } else {
       previous_hand_.clear();
     }
+    // The object frame's origin is the first frame's object points' centroid: within a few cm
+    // of the object's centre, a few degrees of the direction to a camera half a metre away.
+    if (status != FusionStatus::kSkipped) coverage_.Observe(result.cam_from_object, {0, 0, 0});
+    result.coverage = coverage_.Share();
     result.milliseconds = MillisecondsSince(started_at);
     return std::move(result);
   };

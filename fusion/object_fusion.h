@@ -18,6 +18,7 @@
 #include "fusion/model_contacts.h"
 #include "fusion/pairwise_registration.h"
 #include "fusion/tsdf_volume.h"
+#include "fusion/view_coverage.h"
 
 namespace ihs::fusion {
 
@@ -29,6 +30,8 @@ struct FusionOptions {
   /// Fingertip contacts found against the model besides the tracker's (model_contacts.h);
   /// they need FusionInput's hand vertices and fingertips.
   ModelContactOptions model_contacts;
+  /// How the share of the object seen so far is counted (FusionResult::coverage).
+  ViewCoverageOptions coverage;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -106,6 +109,9 @@ struct FusionResult {
   PairwiseResult pairwise;
   IcpResult icp;
   int integrated_voxels = 0;
+  /// The share of directions around the object the registered frames so far have seen it
+  /// from (view_coverage.h), this frame included when registered: how complete the model is.
+  double coverage = 0;
   /// Contacts registered against their anchor rather than the previous frame.
   int anchored_contacts = 0;
   /// Contact pairs found against the model that the tracker's contacts did not have (they are
@@ -165,6 +171,7 @@ class ObjectFusion {
   const CameraIntrinsics intrinsics_;
   const FusionOptions options_;
   TsdfVolume volume_;
+  ViewCoverage coverage_;
   // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
   RaycastImage model_image_;
   std::vector<std::uint16_t> near_depth_;

@@ -165,6 +165,9 @@ int Run(const Args& args) {
   std::printf("mesh: %s (%zu faces, %s)\n", (out / "mesh.ply").c_str(),
               meshes.watertight.faces.size(),
               meshes.watertight.IsWatertight() ? "watertight" : "NOT watertight");
+  std::printf("coverage: seen from %.1f %% of the directions around it, %.1f %% of the "
+              "watertight mesh never seen\n",
+              100 * record.coverage(), 100 * meshes.unseen_share);
 
   if (!args.gt.empty()) {
     // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's

@@ -187,7 +187,19 @@ TEST_F(PipelineFaultTest, AnExportOnRequestWritesAValidMeshAndTheScanGoesOn) {
     EXPECT_EQ(partial_stats["summary"]["final"], false);
     EXPECT_LE(partial_stats["summary"]["frames"].get<int>(), 25);
   }
-  EXPECT_EQ(Stats(out.path())["summary"]["frames"], 25);
+  const nlohmann::json stats = Stats(out.path());
+  EXPECT_EQ(stats["summary"]["frames"], 25);
+  // The share of the object seen: at least the first view's (37 % of the directions), never
+  // less than a frame before, the last frame's in the summary.
+  double seen = 0;
+  for (const nlohmann::json& frame : stats["frames"]) {
+    if (!frame.contains("coverage")) continue;
+    EXPECT_GE(frame["coverage"].get<double>(), seen);
+    seen = frame["coverage"].get<double>();
+  }
+  EXPECT_GT(seen, 0.36);
+  EXPECT_LE(seen, 1.0);
+  EXPECT_EQ(stats["summary"]["coverage"].get<double>(), seen);
 }
 
 TEST_F(PipelineFaultTest, StopFinishesTheFramesInHandAndExports) {

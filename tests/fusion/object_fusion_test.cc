@@ -112,13 +112,22 @@ int Count(const SequenceRun& run, FusionStatus status) {
 TEST(ObjectFusionTest, AFullTurnOfAnEllipsoidWithContactsAndIcpStaysOnTrack) {
   const Eigen::Vector3d axes(45, 30, 18);
   const SequenceRun run = FuseSequence(axes, 6, {});
-  std::printf("ellipsoid, contacts + ICP: %d fused, worst pose error %.2f mm, mesh error %.3f mm\n",
-              Count(run, FusionStatus::kFused), run.pose_error_mm, MeshError(run.mesh, axes));
+  std::printf(
+      "ellipsoid, contacts + ICP: %d fused, worst pose error %.2f mm, mesh error %.3f mm, "
+      "coverage %.3f after one frame, %.3f at the end\n",
+      Count(run, FusionStatus::kFused), run.pose_error_mm, MeshError(run.mesh, axes),
+      run.results.front().coverage, run.results.back().coverage);
   EXPECT_EQ(run.results.front().status, FusionStatus::kStarted);
   EXPECT_EQ(Count(run, FusionStatus::kFused), kFrames - 1);
   // Measured: worst pose error 1.41 mm over the turn, mesh 0.25 mm from the surface.
   EXPECT_LT(run.pose_error_mm, 3.0);
   EXPECT_LT(MeshError(run.mesh, axes), 0.5);
+  // Coverage: one view sees the directions within 75° of the camera's, (1 - cos 75°) / 2 =
+  // 37.1 % of them; the turn about an axis 100.9° from the camera's direction sweeps the
+  // directions 25.9°-175.9° from that axis, (cos 25.9° - cos 175.9°) / 2 = 94.9 %.
+  EXPECT_NEAR(run.results.front().coverage, 0.371, 0.02);
+  EXPECT_NEAR(run.results.back().coverage, 0.949, 0.02);
+  for (int i = 1; i < kFrames; ++i) EXPECT_GE(run.results[i].coverage, run.results[i - 1].coverage);
 }
 
 TEST(ObjectFusionTest, OnASphereOnlyTheContactsKeepTheTurn) {
