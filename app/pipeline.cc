@@ -123,6 +123,7 @@ struct Pipeline::Shared {
   std::condition_variable done;
   std::string tracking = "waiting";
   std::string end_reason;
+  std::string nothing_scanned;  // ScanRecord::NothingScanned() when the scan ends.
   std::string failed_stage;
   std::exception_ptr failure;
   std::vector<std::filesystem::path> final_files;
@@ -347,6 +348,10 @@ void Pipeline::FusionLoop() {
     Fail("fusion", std::current_exception());
   }
   s.tracked.Abandon();  // Releases a tracker thread blocked on a full queue.
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.nothing_scanned = record->NothingScanned();
+  }
   try {
     submit(ExportJob::Kind::kFinal, nullptr);
   } catch (...) {
@@ -417,7 +422,8 @@ void Pipeline::ExportLoop() {
       job->record->WriteStats(output_.folder / "stats.json", extra);
       ++s.exports;
       if (exported.files.empty()) {
-        spdlog::warn("export: nothing to mesh yet");
+        // The final one: the scan's end says "nothing was scanned" and why.
+        if (!final) spdlog::warn("export: nothing to mesh yet");
       } else {
         const double coverage = job->record->coverage();
         spdlog::info(
@@ -500,8 +506,7 @@ PipelineResult Pipeline::Finish() {
     result.error = source_->Description() + ": no frames";
   } else if (result.files.empty()) {
     result.exit_code = kExitStageFailed;
-    result.error =
-        "nothing was scanned: no frame could be registered (see stats.json's skip_reasons)";
+    result.error = s.nothing_scanned;
   }
   return result;
 }

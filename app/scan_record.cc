@@ -112,6 +112,15 @@ void ScanRecord::Add(const FramePacket& packet) {
   ++frames_;
 }
 
+std::string ScanRecord::NothingScanned() const {
+  std::string skipped;
+  for (const auto& [reason, count] : skip_reasons_)
+    skipped += (skipped.empty() ? "" : ", ") + reason + " × " + std::to_string(count);
+  return "nothing was scanned: no frame could be registered (" +
+         (skipped.empty() ? std::string("none was skipped") : skipped) +
+         "; stats.json has each frame's reason)";
+}
+
 nlohmann::json ScanRecord::Summary() const {
   nlohmann::json ms = nlohmann::json::object();
   for (const auto& [key, sum_count] : stage_ms_) {

@@ -35,6 +35,9 @@ class ScanRecord {
   /// The object's pose in each registered frame (cam_from_object, mm).
   const std::vector<StampedPose>& trajectory() const { return trajectory_; }
 
+  /// What to tell a user whose scan registered no frame: "nothing was scanned: no frame could
+  /// be registered (no hand × 12; …)", the skip reasons counted.
+  std::string NothingScanned() const;
   /// Totals: counts by status and reason, mean ms per stage, latency percentiles.
   nlohmann::json Summary() const;
 

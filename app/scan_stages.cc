@@ -104,9 +104,12 @@ ObjectStage::~ObjectStage() = default;
 
 void ObjectStage::Process(FramePacket& packet) {
   if (!packet.frame_error.empty()) {
-    packet.fusion = {};
-    packet.fusion.status = fusion::FusionStatus::kSkipped;
-    packet.fusion.reason = "malformed frame: " + packet.frame_error;
+    packet.fusion = fusion_.Skip("malformed frame: " + packet.frame_error);
+    return;
+  }
+  if (!options_.fuse_without_hand && !packet.track.HasPose()) {
+    packet.fusion = fusion_.Skip(std::string("no hand: the tracker's frame is ") +
+                                 tracker::ToString(packet.track.status));
     return;
   }
   const Frame& frame = *packet.frame;

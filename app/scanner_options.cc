@@ -45,6 +45,9 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "the scanning hand is a left one (the procedural template is mirrored)");
   r.Add("scan.hand_dilation_px", &scan.hand_dilation_px,
         "pixels around the posed hand model never counted as the object");
+  r.Add("scan.fuse_without_hand", &scan.fuse_without_hand,
+        "fuse frames without a tracked hand too (an object that is not held; off: skipped as "
+        "'no hand')");
   r.Add("scan.hand_depth_margin_mm", &scan.hand_depth_margin_mm,
         "the hand model hides object pixels up to this far behind the observed depth, mm");
   r.Add("scan.features_2d", &scan.features_2d, "SIFT matches on the object's colour (E_feat2d)");

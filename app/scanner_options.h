@@ -36,6 +36,12 @@ struct ScanOptions {
   /// ISS3D + CSHOT matches on the object's points (E_feat3d; off by default: about 200 ms per
   /// frame, and misleading on symmetric objects).
   bool features_3d = false;
+  /// Fuse frames in which the tracker has no hand it trusts (no hand found, or a fit that does
+  /// not explain the data). Off: such a frame is skipped with the reason "no hand", so neither a
+  /// hand the tracker lost (its pixels are not masked out) nor a scene without a hand is fused,
+  /// and a recording without a hand scans nothing. On: for an object that is not held (a
+  /// turntable), where every frame's non-skin pixels are fused as the tracker segments them.
+  bool fuse_without_hand = false;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

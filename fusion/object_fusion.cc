@@ -49,6 +49,15 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       coverage_(options_.coverage),
       contact_noise_mm_(options_.contact_noise_reference_mm) {}
 
+FusionResult ObjectFusion::Skip(std::string reason) const {
+  FusionResult result;
+  result.status = FusionStatus::kSkipped;
+  result.reason = std::move(reason);
+  result.cam_from_object = cam_from_object_;
+  result.coverage = coverage_.Share();
+  return result;
+}
+
 int ObjectFusion::AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
                                    std::vector<int>* contact_ids) const {
   if (!options_.model_contacts.enabled || !input.hand_vertices || !input.fingertips ||

@@ -144,6 +144,9 @@ class ObjectFusion {
   ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options = {});
 
   FusionResult Fuse(const FusionInput& input);
+  /// The result for a frame the caller does not fuse (`reason`: why): skipped, with the pose
+  /// and the coverage so far.
+  FusionResult Skip(std::string reason) const;
 
   /// The raw marching-cubes mesh of the model so far (object frame, mm).
   TriangleMesh ExtractMesh() const { return volume_.ExtractMesh(); }

@@ -121,7 +121,12 @@ int Run(const Args& args) {
   const ihs::app::ExportedMeshes exported = ihs::app::ExportMeshes(raw, options.meshing, out);
   const double export_ms = ihs::MillisecondsSince(start);
   const fusion::MeshingResult& meshes = exported.meshes;
-  if (exported.files.empty()) throw ihs::InputError(args.input + ": nothing was scanned");
+  if (exported.files.empty()) {
+    // As `inhandscan replay` ends it: code 5 and the skip reasons.
+    std::fprintf(stderr, "inhandscan-scan: error: %s: %s\n", args.input.c_str(),
+                 record.NothingScanned().c_str());
+    return ihs::kExitStageFailed;
+  }
   record.WriteTables(out);
 
   nlohmann::json summary = record.Summary();

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/mesh_io.h"
+#include "sensor/oni_writer.h"
+#include "tests/frame_fixtures.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
 
@@ -81,6 +83,43 @@ TEST(InhandscanTest, LiveWithoutACameraSaysSoWithCodeFour) {
   const auto devices = RunApp("devices");
   EXPECT_EQ(devices.exit_code, 4) << devices.err;
   EXPECT_NE(devices.out.find("OpenNI2"), std::string::npos) << devices.out;
+}
+
+// A scene without a hand ends the same way whichever recording shows it: no frame is fused
+// (the tracker has no hand in any), code 5, one line that says so.
+void ExpectNothingScannedForWantOfAHand(const fs::path& recording, const fs::path& out) {
+  const auto run = RunApp("replay " + recording.string() + " --out " + out.string() +
+                          " --set pipeline.preview_every=0 -q");
+  EXPECT_EQ(run.exit_code, 5) << run.err;
+  EXPECT_NE(run.err.find("nothing was scanned"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("no hand ×"), std::string::npos) << run.err;
+  EXPECT_EQ(Lines(run.err), 1) << run.err;
+  EXPECT_FALSE(fs::exists(out / "mesh.ply"));
+}
+
+TEST(InhandscanTest, RecordingsWithoutAHandScanNothingAndSaySo) {
+  test::TempDir dir;
+  // A generated ball turning in front of the camera, no hand anywhere.
+  sensor::OniWriterOptions options;
+  {
+    sensor::OniWriter writer(dir / "ball.oni", options);
+    for (int i = 0; i < 8; ++i) {
+      Frame frame = test::RenderEllipsoid(
+          options.intrinsics,
+          Rigid3::Translation({0, 0, 550}) * Rigid3::FromAxisAngle({0, 1, 0}, i * 0.05),
+          {35, 35, 35});
+      frame.index = i;
+      frame.depth_timestamp_us = i * 33333;
+      frame.color_timestamp_us = frame.depth_timestamp_us;
+      writer.Write(frame);
+    }
+    writer.Close();
+  }
+  ExpectNothingScannedForWantOfAHand(dir / "ball.oni", dir / "ball");
+  // The real Kinect recording of a room.
+  const fs::path real = test::KinectRecording();
+  if (real.empty()) GTEST_SKIP() << "no shared data: the real recording's case is left out";
+  ExpectNothingScannedForWantOfAHand(real, dir / "room");
 }
 
 class InhandscanSignalTest : public ::testing::Test {
