@@ -409,7 +409,8 @@ void Pipeline::ExportLoop() {
                                 {"poisson", exported.meshes.poisson_ms}}},
                               {"mesh",
                                {{"faces", exported.meshes.watertight.faces.size()},
-                                {"watertight", exported.meshes.watertight.IsWatertight()},
+                                {"watertight", exported.meshes.IsWatertight()},
+                                {"self_intersections", exported.meshes.self_intersections},
                                 {"unseen_share", exported.meshes.unseen_share},
                                 {"volume_mm3", exported.meshes.watertight.IsWatertight()
                                                    ? exported.meshes.watertight.Volume()
@@ -421,6 +422,12 @@ void Pipeline::ExportLoop() {
       }
       job->record->WriteStats(output_.folder / "stats.json", extra);
       ++s.exports;
+      if (exported.meshes.self_intersections > 0) {
+        spdlog::warn(
+            "export: the closed mesh crosses itself ({} pairs of faces): closed and manifold, "
+            "but not watertight to a slicer",
+            exported.meshes.self_intersections);
+      }
       if (exported.files.empty()) {
         // The final one: the scan's end says "nothing was scanned" and why.
         if (!final) spdlog::warn("export: nothing to mesh yet");

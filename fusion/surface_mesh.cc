@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/mesh_intersections.h"
 #include "core/point_kd_tree.h"
 #include "core/stopwatch.h"
 #include "fusion/measure.h"
@@ -299,6 +300,7 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options)
                            options.poisson_scale, options.color),
         options.min_component_fraction);
     result.unseen_share = UnseenShare(result.watertight, result.smoothed);
+    result.self_intersections = FindSelfIntersections(result.watertight, 0).pairs;
     result.poisson_ms = MillisecondsSince(start);
   }
   return result;

@@ -5,6 +5,8 @@
 // screened Poisson reconstruction (Kazhdan et al., through PCL) into a closed, watertight mesh
 // with the colours carried over from the raw one.
 
+#include <cstdint>
+
 #include "core/triangle_mesh.h"
 
 namespace ihs::fusion {
@@ -69,6 +71,11 @@ struct MeshingResult {
   /// Share of `watertight`'s surface farther than 2 mm from `smoothed`: what no frame saw and
   /// Poisson made up (UnseenShare); its volume is a guess over that part. 0 without `watertight`.
   double unseen_share = 0;
+  /// Pairs of `watertight`'s faces that cross (FindSelfIntersections): Poisson can fold its
+  /// surface through itself, and such a mesh is closed and manifold but not watertight.
+  std::int64_t self_intersections = 0;
+  /// `watertight` is closed, edge-manifold, oriented and does not cross itself.
+  bool IsWatertight() const { return watertight.IsWatertight() && self_intersections == 0; }
   /// Time spent, ms.
   double cleanup_ms = 0;
   double smoothing_ms = 0;

@@ -17,6 +17,7 @@
 #include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
+#include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
 #include "core/trajectory_io.h"
 #include "fusion/measure.h"
@@ -33,14 +34,14 @@ int Run(const std::string& mesh_path, const std::string& seen_path, const std::s
   const ihs::fusion::RevolutionMeasures measures = ihs::fusion::MeasureRevolution(mesh);
   nlohmann::json out = {{"mesh", mesh_path},
                         {"faces", mesh.faces.size()},
-                        {"watertight", mesh.IsWatertight()},
+                        {"watertight", ihs::IsWatertightWithoutSelfIntersections(mesh)},
                         {"height_mm", measures.height_mm},
                         {"widest_diameter_mm", measures.widest_diameter_mm},
                         {"widest_at_mm", measures.widest_at_mm},
                         {"head_diameter_mm", measures.head_diameter_mm},
                         {"axis", {measures.axis.x(), measures.axis.y(), measures.axis.z()}}};
   std::printf("mesh: %s (%zu faces, %s)\n", mesh_path.c_str(), mesh.faces.size(),
-              mesh.IsWatertight() ? "watertight" : "not watertight");
+              ihs::IsWatertightWithoutSelfIntersections(mesh) ? "watertight" : "not watertight");
   std::printf("axis: %.3f %.3f %.3f; height %.2f mm; widest section Ø%.2f mm at %.1f mm",
               measures.axis.x(), measures.axis.y(), measures.axis.z(), measures.height_mm,
               measures.widest_diameter_mm, measures.widest_at_mm);

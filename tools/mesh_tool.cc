@@ -10,6 +10,7 @@
 #include "core/command_line.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
+#include "core/mesh_intersections.h"
 #include "core/mesh_io.h"
 
 namespace {
@@ -18,7 +19,9 @@ int PrintInfo(const std::string& path) {
   const ihs::TriangleMesh mesh = ihs::ReadMesh(path);
   const auto [lo, hi] = mesh.Bounds();
   const Eigen::Vector3f size = hi - lo;
-  const bool watertight = mesh.IsWatertight();
+  const bool closed = mesh.IsWatertight();
+  const std::int64_t crossings = closed ? ihs::FindSelfIntersections(mesh, 0).pairs : 0;
+  const bool watertight = closed && crossings == 0;
   std::printf("file: %s\n", path.c_str());
   std::printf("vertices: %zu\n", mesh.vertices.size());
   std::printf("faces: %zu\n", mesh.faces.size());
@@ -29,7 +32,8 @@ int PrintInfo(const std::string& path) {
   std::printf("size_mm: %.3f %.3f %.3f\n", size.x(), size.y(), size.z());
   std::printf("area_mm2: %.3f\n", mesh.SurfaceArea());
   std::printf("watertight: %s\n", watertight ? "yes" : "no");
-  if (watertight) std::printf("volume_mm3: %.3f\n", mesh.Volume());
+  if (closed) std::printf("self_intersections: %lld\n", static_cast<long long>(crossings));
+  if (closed) std::printf("volume_mm3: %.3f\n", mesh.Volume());
   return ihs::kExitOk;
 }
 

@@ -144,7 +144,8 @@ int Run(const Args& args) {
         {"poisson", meshes.poisson_ms}}},
       {"mesh",
        {{"faces", meshes.watertight.faces.size()},
-        {"watertight", meshes.watertight.IsWatertight()},
+        {"watertight", meshes.IsWatertight()},
+        {"self_intersections", meshes.self_intersections},
         {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
 
   auto count = [](const nlohmann::json& counts, const char* key) {
@@ -169,7 +170,9 @@ int Run(const Args& args) {
               meshes.poisson_ms);
   std::printf("mesh: %s (%zu faces, %s)\n", (out / "mesh.ply").c_str(),
               meshes.watertight.faces.size(),
-              meshes.watertight.IsWatertight() ? "watertight" : "NOT watertight");
+              meshes.IsWatertight()                 ? "watertight"
+              : meshes.watertight.IsWatertight() ? "closed but crossing itself: NOT watertight"
+                                                 : "NOT watertight");
   std::printf("coverage: seen from %.1f %% of the directions around it, %.1f %% of the "
               "watertight mesh never seen\n",
               100 * record.coverage(), 100 * meshes.unseen_share);

@@ -200,6 +200,9 @@ TEST_F(PipelineFaultTest, AnExportOnRequestWritesAValidMeshAndTheScanGoesOn) {
   EXPECT_GT(seen, 0.36);
   EXPECT_LE(seen, 1.0);
   EXPECT_EQ(stats["summary"]["coverage"].get<double>(), seen);
+  // Every export checks its closed mesh for faces that cross (none on this ball).
+  EXPECT_EQ(stats["summary"]["mesh"]["self_intersections"], 0);
+  EXPECT_EQ(stats["summary"]["mesh"]["watertight"], true);
 }
 
 TEST_F(PipelineFaultTest, StopFinishesTheFramesInHandAndExports) {

@@ -36,7 +36,24 @@ TEST(MeshToolTest, InfoReportsCountsSizeAndVolume) {
   EXPECT_NE(run.output.find("faces: 12\n"), std::string::npos);
   EXPECT_NE(run.output.find("size_mm: 20.000 20.000 20.000\n"), std::string::npos);
   EXPECT_NE(run.output.find("watertight: yes\n"), std::string::npos);
+  EXPECT_NE(run.output.find("self_intersections: 0\n"), std::string::npos);
   EXPECT_NE(run.output.find("volume_mm3: 8000.000\n"), std::string::npos);
+}
+
+TEST(MeshToolTest, AClosedMeshThatCrossesItselfIsNotWatertight) {
+  // Two cubes overlapping in one mesh: every edge has its two faces, but the surfaces cross.
+  test::TempDir dir;
+  TriangleMesh cubes = test::MakeCube(20);
+  const TriangleMesh second = test::MakeCube(20);
+  for (const Eigen::Vector3f& v : second.vertices) cubes.vertices.push_back(v + Eigen::Vector3f(7, 5, 3));
+  for (const TriangleMesh::Face& f : second.faces) cubes.faces.push_back({f[0] + 8, f[1] + 8, f[2] + 8});
+  cubes.normals.clear();
+  WriteMesh(dir / "cubes.ply", cubes);
+  const ToolRun run = RunTool("info " + (dir / "cubes.ply").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("watertight: no\n"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("self_intersections: 0\n"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("self_intersections: "), std::string::npos) << run.output;
 }
 
 TEST(MeshToolTest, ConvertsBetweenFormats) {
