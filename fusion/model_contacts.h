@@ -20,8 +20,9 @@ namespace ihs::fusion {
 
 /// Options of the contacts found against the model.
 struct ModelContactOptions {
-  /// Find them (false: only the tracker's contacts).
-  bool enabled = false;
+  /// Find them (false: only the tracker's contacts). On since their contacts hold ICP only in
+  /// the directions the surface leaves free (docs/fusion.md: measured on twelve full turns).
+  bool enabled = true;
   /// A fingertip vertex is on the surface when the model's signed distance there is at most
   /// this, mm (inside the object counts too). The model knows distances only within its
   /// truncation band (TsdfOptions::truncation_voxels, 5.5 mm by default), so this must be less.
