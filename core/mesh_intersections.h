@@ -25,7 +25,8 @@ struct SelfIntersections {
 /// plane), and those that meet along the vertices or the edge they share, do not count; nor do
 /// coplanar overlaps, which a fold through the surface also shows as crossing edges.
 /// Faces near each other are found through a grid of cells about twice a face's size, so the
-/// cost grows with the faces, not their square (about 0.1 s for 100 000 faces).
+/// cost grows with the faces, not their square (`inhandscan-mesh info` on a 57 586-face
+/// mesh.ply: 0.13 s, reading included).
 SelfIntersections FindSelfIntersections(const TriangleMesh& mesh, int max_examples = 10);
 
 /// Closed, edge-manifold, oriented (TriangleMesh::IsWatertight) and without self-intersections.

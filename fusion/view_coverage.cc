@@ -17,10 +17,10 @@ void ViewCoverageOptions::Check() const {
 }
 
 ViewCoverage::ViewCoverage(ViewCoverageOptions options)
-    : options_((options.Check(), options)),
-      cos_max_incidence_(std::cos(options.max_incidence_deg * std::numbers::pi / 180.0)) {
+    : cos_max_incidence_((options.Check(),
+                          std::cos(options.max_incidence_deg * std::numbers::pi / 180.0))) {
   // A Fibonacci lattice: equal areas in z, the golden angle around it.
-  const int n = options_.directions;
+  const int n = options.directions;
   const double golden_angle = std::numbers::pi * (3.0 - std::sqrt(5.0));
   directions_.reserve(n);
   for (int i = 0; i < n; ++i) {

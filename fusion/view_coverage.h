@@ -39,7 +39,6 @@ class ViewCoverage {
   double Share() const;
 
  private:
-  ViewCoverageOptions options_;
   double cos_max_incidence_;
   std::vector<Eigen::Vector3d> directions_;
   std::vector<std::uint8_t> seen_;

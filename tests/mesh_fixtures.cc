@@ -43,4 +43,14 @@ TriangleMesh MakeUvSphere(float radius_mm, int rings, int segments, const Eigen:
   return mesh;
 }
 
+TriangleMesh MergeMeshes(TriangleMesh a, const TriangleMesh& b, const Eigen::Vector3f& shift) {
+  const auto offset = static_cast<std::int32_t>(a.vertices.size());
+  for (const Eigen::Vector3f& v : b.vertices) a.vertices.push_back(v + shift);
+  for (const TriangleMesh::Face& f : b.faces) {
+    a.faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
+  }
+  a.normals.clear();
+  return a;
+}
+
 }  // namespace ihs::test

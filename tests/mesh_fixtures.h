@@ -13,4 +13,7 @@ TriangleMesh MakeCube(float edge_mm);
 TriangleMesh MakeUvSphere(float radius_mm, int rings, int segments,
                           const Eigen::Vector3f& center = Eigen::Vector3f::Zero());
 
+/// `a` and `b` moved by `shift` as one mesh of two parts (without normals).
+TriangleMesh MergeMeshes(TriangleMesh a, const TriangleMesh& b, const Eigen::Vector3f& shift);
+
 }  // namespace ihs::test

@@ -4,19 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "tests/mesh_fixtures.h"
 
 namespace ihs {
 namespace {
-
-// `b`'s faces appended to `a`'s (one mesh of two closed parts).
-TriangleMesh Merge(TriangleMesh a, const TriangleMesh& b, const Eigen::Vector3f& shift) {
-  const auto offset = static_cast<std::int32_t>(a.vertices.size());
-  for (const Eigen::Vector3f& v : b.vertices) a.vertices.push_back(v + shift);
-  for (const TriangleMesh::Face& f : b.faces) a.faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
-  a.normals.clear();
-  return a;
-}
 
 TEST(MeshIntersectionsTest, ClosedSurfacesThatDoNotCrossHaveNone) {
   const TriangleMesh sphere = test::MakeUvSphere(35, 24, 48);
@@ -24,8 +17,8 @@ TEST(MeshIntersectionsTest, ClosedSurfacesThatDoNotCrossHaveNone) {
   EXPECT_TRUE(IsWatertightWithoutSelfIntersections(sphere));
   // Two cubes apart, and two touching face to face: not crossing.
   const TriangleMesh cube = test::MakeCube(10);
-  EXPECT_EQ(FindSelfIntersections(Merge(cube, cube, {30, 0, 0})).pairs, 0);
-  EXPECT_EQ(FindSelfIntersections(Merge(cube, cube, {10, 0, 0})).pairs, 0);
+  EXPECT_EQ(FindSelfIntersections(test::MergeMeshes(cube, cube, {30, 0, 0})).pairs, 0);
+  EXPECT_EQ(FindSelfIntersections(test::MergeMeshes(cube, cube, {10, 0, 0})).pairs, 0);
   EXPECT_EQ(FindSelfIntersections(TriangleMesh{}).pairs, 0);
 }
 
@@ -33,7 +26,7 @@ TEST(MeshIntersectionsTest, TwoOverlappingClosedPartsCross) {
   // Each cube is closed and oriented, so the merged mesh passes the edge test; their surfaces
   // cross along a closed line, through faces of both.
   const TriangleMesh cube = test::MakeCube(10);
-  const TriangleMesh merged = Merge(cube, cube, {4, 3, 2});
+  const TriangleMesh merged = test::MergeMeshes(cube, cube, {4, 3, 2});
   ASSERT_TRUE(merged.IsWatertight());
   const SelfIntersections found = FindSelfIntersections(merged, 100);
   EXPECT_GT(found.pairs, 0);

@@ -43,11 +43,7 @@ TEST(MeshToolTest, InfoReportsCountsSizeAndVolume) {
 TEST(MeshToolTest, AClosedMeshThatCrossesItselfIsNotWatertight) {
   // Two cubes overlapping in one mesh: every edge has its two faces, but the surfaces cross.
   test::TempDir dir;
-  TriangleMesh cubes = test::MakeCube(20);
-  const TriangleMesh second = test::MakeCube(20);
-  for (const Eigen::Vector3f& v : second.vertices) cubes.vertices.push_back(v + Eigen::Vector3f(7, 5, 3));
-  for (const TriangleMesh::Face& f : second.faces) cubes.faces.push_back({f[0] + 8, f[1] + 8, f[2] + 8});
-  cubes.normals.clear();
+  const TriangleMesh cubes = test::MergeMeshes(test::MakeCube(20), test::MakeCube(20), {7, 5, 3});
   WriteMesh(dir / "cubes.ply", cubes);
   const ToolRun run = RunTool("info " + (dir / "cubes.ply").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
