@@ -31,7 +31,7 @@ using PacketPtr = std::unique_ptr<FramePacket>;
 // A snapshot for the export thread: a preview or a mesh export.
 struct ExportJob {
   enum class Kind { kPreview, kExport, kFinal } kind = Kind::kExport;
-  TriangleMesh model;  // Exports: raw marching cubes, object frame.
+  fusion::ModelSnapshot model;  // Exports: raw marching cubes and free space, object frame.
   // Previews: what the camera saw, the model seen from the camera, and the posed hand.
   std::shared_ptr<const Frame> frame;
   ModelView model_view;
@@ -406,12 +406,14 @@ void Pipeline::ExportLoop() {
                                {{"total", exported.milliseconds},
                                 {"cleanup", exported.meshes.cleanup_ms},
                                 {"smoothing", exported.meshes.smoothing_ms},
-                                {"poisson", exported.meshes.poisson_ms}}},
+                                {"poisson", exported.meshes.poisson_ms},
+                                {"bound", exported.meshes.bound_ms}}},
                               {"mesh",
                                {{"faces", exported.meshes.watertight.faces.size()},
                                 {"watertight", exported.meshes.IsWatertight()},
                                 {"self_intersections", exported.meshes.self_intersections},
                                 {"unseen_share", exported.meshes.unseen_share},
+                                {"cut_share", exported.meshes.cut_share},
                                 {"volume_mm3", exported.meshes.watertight.IsWatertight()
                                                    ? exported.meshes.watertight.Volume()
                                                    : 0.0}}}};

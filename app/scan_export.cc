@@ -5,13 +5,14 @@
 
 namespace ihs::app {
 
-ExportedMeshes ExportMeshes(const TriangleMesh& raw, const fusion::MeshingOptions& options,
+ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
+                            const fusion::MeshingOptions& options,
                             const std::filesystem::path& folder,
                             const std::vector<std::string>& extra_formats) {
   const auto start = SteadyClock::now();
   ExportedMeshes exported;
-  if (raw.faces.empty()) return exported;
-  exported.meshes = fusion::MakeMeshes(raw, options);
+  if (model.raw.faces.empty()) return exported;
+  exported.meshes = fusion::MakeMeshes(model.raw, options, &model.free_space);
   if (exported.meshes.smoothed.Empty()) return exported;
   WriteMesh(folder / "mesh_tsdf.ply", exported.meshes.smoothed);
   exported.files.push_back(folder / "mesh_tsdf.ply");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/triangle_mesh.h"
+#include "fusion/object_fusion.h"
 #include "fusion/surface_mesh.h"
 
 namespace ihs::app {
@@ -21,11 +22,12 @@ struct ExportedMeshes {
   double milliseconds = 0;
 };
 
-/// Meshes `raw` with `options` and writes into `folder`: mesh_tsdf.ply (the smoothed surface),
+/// Meshes `model` (its raw mesh, bounded by its free space) with `options` and writes into `folder`: mesh_tsdf.ply (the smoothed surface),
 /// mesh.ply (the watertight mesh; the smoothed one when Poisson is off or gave nothing) and
 /// mesh.<ext> of the same for each of `extra_formats` ("obj", "stl"; "ply" adds nothing). Nothing
-/// is written when `raw` has no faces. Throws ihs::OutputError when a file cannot be written.
-ExportedMeshes ExportMeshes(const TriangleMesh& raw, const fusion::MeshingOptions& options,
+/// is written when the raw mesh has no faces. Throws ihs::OutputError when a file cannot be written.
+ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
+                            const fusion::MeshingOptions& options,
                             const std::filesystem::path& folder,
                             const std::vector<std::string>& extra_formats = {});
 

@@ -132,12 +132,12 @@ void ObjectStage::Process(FramePacket& packet) {
   packet.shot_matches = static_cast<int>(input.correspondences.features_3d.size());
   packet.contact_pairs = static_cast<int>(input.correspondences.contacts.size());
   if (packet.hand_mesh && packet.fingertips) {
-    input.hand_vertices = &packet.hand_mesh->vertices;
+    input.hand = packet.hand_mesh.get();
     input.fingertips = packet.fingertips.get();
   }
   packet.fusion = fusion_.Fuse(input);
 }
 
-TriangleMesh ObjectStage::Snapshot() const { return fusion_.ExtractMesh(); }
+fusion::ModelSnapshot ObjectStage::Snapshot() const { return fusion_.Snapshot(); }
 
 }  // namespace ihs::app

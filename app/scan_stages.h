@@ -98,8 +98,8 @@ class ObjectStage {
 
   /// Fills the packet's fusion fields (a malformed frame is skipped with its reason).
   void Process(FramePacket& packet);
-  /// The raw marching-cubes mesh of the model so far (object frame, mm): an immutable copy.
-  TriangleMesh Snapshot() const;
+  /// The model so far as an export needs it (an immutable copy).
+  fusion::ModelSnapshot Snapshot() const;
   /// Whether the model has been started (a first frame fused).
   bool started() const { return fusion_.started(); }
   /// The model (for a raycast view); only the owning thread may read it.

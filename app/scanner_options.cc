@@ -168,6 +168,18 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("fusion.coverage.max_incidence_deg", &u.coverage.max_incidence_deg,
         "a surface counts as seen from a camera within this angle of its normal, degrees "
         "(coverage)");
+  r.Add("fusion.free_space.enabled", &u.free_space.enabled,
+        "keep the depth of frames from new directions to bound the closed mesh by the space "
+        "seen empty");
+  r.Add("fusion.free_space.min_turn_deg", &u.free_space.min_turn_deg,
+        "a frame is kept when the object has turned this far from every kept one, degrees");
+  r.Add("fusion.free_space.max_views", &u.free_space.max_views, "views kept at most");
+  r.Add("fusion.free_space.margin_mm", &u.free_space.margin_mm,
+        "space counts as seen empty only this far in front of the measured depth, mm");
+  r.Add("fusion.free_space.min_views", &u.free_space.min_views,
+        "views that must see through a point for it to be empty");
+  r.Add("fusion.free_space.no_depth_is_empty", &u.free_space.no_depth_is_empty,
+        "pixels without depth far from any with depth are rays that met nothing");
   r.Add("fusion.tsdf.size_mm", &u.tsdf.size_mm, "edge of the TSDF cube, mm (paper: 350)");
   r.Add("fusion.tsdf.resolution", &u.tsdf.resolution, "TSDF voxels per edge (paper: 256)");
   r.Add("fusion.tsdf.truncation_voxels", &u.tsdf.truncation_voxels,
@@ -215,6 +227,10 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("mesh.poisson_samples_per_node", &m.poisson_samples_per_node,
         "Poisson minimum samples per octree node");
   r.Add("mesh.poisson_scale", &m.poisson_scale, "Poisson cube edge over the points' bounding box");
+  r.Add("mesh.bound_voxel_mm", &m.bound_voxel_mm,
+        "lattice step of the closed mesh cut back to the space not seen empty, mm");
+  r.Add("mesh.bound_keep_seen_mm", &m.bound_keep_seen_mm,
+        "nothing within this of the seen surface is cut, mm");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
 
   PipelineOptions& p = options->pipeline;

@@ -29,6 +29,7 @@ void FusionOptions::Check() const {
   icp.Check();
   model_contacts.Check();
   coverage.Check();
+  free_space.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -47,6 +48,7 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       options_((options.Check(), std::move(options))),
       volume_(options_.tsdf),
       coverage_(options_.coverage),
+      free_space_(intrinsics, options_.free_space),
       contact_noise_mm_(options_.contact_noise_reference_mm) {}
 
 FusionResult ObjectFusion::Skip(std::string reason) const {
@@ -60,14 +62,14 @@ FusionResult ObjectFusion::Skip(std::string reason) const {
 
 int ObjectFusion::AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
                                    std::vector<int>* contact_ids) const {
-  if (!options_.model_contacts.enabled || !input.hand_vertices || !input.fingertips ||
+  if (!options_.model_contacts.enabled || !input.hand || !input.fingertips ||
       previous_hand_.empty() || !started_) {
     return 0;
   }
   // Without ids the tracker's contacts cannot be told apart from the model's: none added.
   if (contact_ids->size() != correspondences->contacts.size()) return 0;
   const std::vector<ModelContact> found =
-      FindModelContacts(volume_, cam_from_object_.Inverse(), previous_hand_, *input.hand_vertices,
+      FindModelContacts(volume_, cam_from_object_.Inverse(), previous_hand_, input.hand->vertices,
                         *input.fingertips, options_.model_contacts);
   std::vector<int> known = *contact_ids;
   std::sort(known.begin(), known.end());
@@ -135,8 +137,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     // The hand of a registered frame, for the next frame's model contacts (kept only when they
     // are looked for: a copy of every vertex each frame).
     if (options_.model_contacts.enabled && status != FusionStatus::kSkipped &&
-        input.hand_vertices) {
-      previous_hand_ = *input.hand_vertices;
+        input.hand) {
+      previous_hand_ = input.hand->vertices;
     } else {
       previous_hand_.clear();
     }
@@ -175,6 +177,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     result.cam_from_object = cam_from_object_;
     const auto integrate_start = SteadyClock::now();
     result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, cam_from_object_);
+    free_space_.Observe(frame, box, cam_from_object_, input.hand);
     result.integrate_ms = MillisecondsSince(integrate_start);
     started_ = true;
     return finish(FusionStatus::kStarted);
@@ -303,6 +306,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   result.cam_from_object = pose;
   const auto integrate_start = SteadyClock::now();
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
+  free_space_.Observe(frame, box, pose, input.hand);
   result.integrate_ms = MillisecondsSince(integrate_start);
   UpdateAnchors(contact_ids, correspondences.contacts, pose);
   return finish(FusionStatus::kFused);

@@ -14,6 +14,7 @@
 #include "core/frame.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
+#include "fusion/free_space.h"
 #include "fusion/icp.h"
 #include "fusion/model_contacts.h"
 #include "fusion/pairwise_registration.h"
@@ -32,6 +33,8 @@ struct FusionOptions {
   ModelContactOptions model_contacts;
   /// How the share of the object seen so far is counted (FusionResult::coverage).
   ViewCoverageOptions coverage;
+  /// Which registered frames' depth is kept to bound the closure by the space seen empty.
+  FreeSpaceOptions free_space;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -82,10 +85,11 @@ struct FusionInput {
   /// For each of `correspondences.contacts`, what identifies the touching skin point from
   /// frame to frame (the hand model's vertex index); empty: contacts are not anchored.
   std::vector<int> contact_ids;
-  /// The posed hand model's vertices in this frame (camera frame, mm) and each fingertip's
-  /// vertex indices: with both, fingertips on the model's surface are contacts too
-  /// (FusionOptions::model_contacts). Null: only `correspondences.contacts`.
-  const std::vector<Eigen::Vector3f>* hand_vertices = nullptr;
+  /// The posed hand model in this frame (camera frame, mm) and each fingertip's vertex
+  /// indices: with both, fingertips on the model's surface are contacts too
+  /// (FusionOptions::model_contacts). Null: only `correspondences.contacts`. The hand's volume
+  /// is space the object is not in (free_space.h).
+  const TriangleMesh* hand = nullptr;
   const std::vector<std::vector<int>>* fingertips = nullptr;
 };
 
@@ -138,6 +142,13 @@ struct FusionResult {
   double integrate_ms = 0;
 };
 
+/// The model as an export needs it, an immutable copy: the raw marching-cubes mesh (object
+/// frame, mm) and the views that bound its closure (free_space.h).
+struct ModelSnapshot {
+  TriangleMesh raw;
+  FreeSpace free_space;
+};
+
 /// Registers and fuses an object frame by frame. Not thread-safe; the fusion thread owns it.
 class ObjectFusion {
  public:
@@ -150,6 +161,9 @@ class ObjectFusion {
 
   /// The raw marching-cubes mesh of the model so far (object frame, mm).
   TriangleMesh ExtractMesh() const { return volume_.ExtractMesh(); }
+  /// The raw mesh with the free-space views (they are shared, not copied).
+  ModelSnapshot Snapshot() const { return {volume_.ExtractMesh(), free_space_}; }
+  const FreeSpace& free_space() const { return free_space_; }
   const TsdfVolume& volume() const { return volume_; }
   bool started() const { return started_; }
   const FusionOptions& options() const { return options_; }
@@ -175,6 +189,7 @@ class ObjectFusion {
   const FusionOptions options_;
   TsdfVolume volume_;
   ViewCoverage coverage_;
+  FreeSpace free_space_;
   // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
   RaycastImage model_image_;
   std::vector<std::uint16_t> near_depth_;

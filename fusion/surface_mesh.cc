@@ -18,6 +18,7 @@
 #include "core/mesh_intersections.h"
 #include "core/point_kd_tree.h"
 #include "core/stopwatch.h"
+#include "fusion/closure_bound.h"
 #include "fusion/measure.h"
 
 namespace ihs::fusion {
@@ -95,6 +96,10 @@ void MeshingOptions::Check() const {
   IHS_CHECK_ARG(
       poisson_samples_per_node >= 1 && poisson_samples_per_node <= 50,
       "meshing.poisson_samples_per_node must be in [1, 50], got " << poisson_samples_per_node);
+  IHS_CHECK_ARG(bound_voxel_mm >= 0.25 && bound_voxel_mm <= 20,
+                "meshing.bound_voxel_mm must be in [0.25, 20], got " << bound_voxel_mm);
+  IHS_CHECK_ARG(bound_keep_seen_mm >= 0 && bound_keep_seen_mm <= 50,
+                "meshing.bound_keep_seen_mm must be in [0, 50], got " << bound_keep_seen_mm);
 }
 
 TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction) {
@@ -280,7 +285,8 @@ TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samp
   return out;
 }
 
-MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options) {
+MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
+                         const FreeSpace* free_space) {
   options.Check();
   MeshingResult result;
   auto start = SteadyClock::now();
@@ -299,9 +305,18 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options)
         PoissonReconstruct(result.smoothed, options.poisson_depth, options.poisson_samples_per_node,
                            options.poisson_scale, options.color),
         options.min_component_fraction);
+    result.poisson_ms = MillisecondsSince(start);
+    if (free_space != nullptr && free_space->views() > 0) {
+      start = SteadyClock::now();
+      ClosureBound bound = BoundByFreeSpace(result.watertight, result.smoothed, *free_space,
+                                            options.bound_voxel_mm, options.bound_keep_seen_mm,
+                                            options.min_component_fraction);
+      result.watertight = std::move(bound.mesh);
+      result.cut_share = bound.removed_share;
+      result.bound_ms = MillisecondsSince(start);
+    }
     result.unseen_share = UnseenShare(result.watertight, result.smoothed);
     result.self_intersections = FindSelfIntersections(result.watertight, 0).pairs;
-    result.poisson_ms = MillisecondsSince(start);
   }
   return result;
 }

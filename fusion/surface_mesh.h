@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "core/triangle_mesh.h"
+#include "fusion/free_space.h"
 
 namespace ihs::fusion {
 
@@ -32,6 +33,12 @@ struct MeshingOptions {
   /// implicit surface to close over what was never seen (under the fingers) inside the cube
   /// rather than running into its faces.
   double poisson_scale = 1.5;
+  /// The closed mesh is cut back to the space no view saw empty (closure_bound.h), remeshed on
+  /// a lattice of this step (mm; about the TSDF's 1.37 mm voxel, finer than Poisson's detail
+  /// on a hand-held object); within `bound_keep_seen_mm` of the seen surface nothing is cut.
+  /// Off when MakeMeshes gets no views.
+  double bound_voxel_mm = 1.0;
+  double bound_keep_seen_mm = 2.0;
   /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).
   bool color = true;
 
@@ -71,6 +78,8 @@ struct MeshingResult {
   /// Share of `watertight`'s surface farther than 2 mm from `smoothed`: what no frame saw and
   /// Poisson made up (UnseenShare); its volume is a guess over that part. 0 without `watertight`.
   double unseen_share = 0;
+  /// Share of Poisson's volume cut because views saw that space empty (0: nothing cut).
+  double cut_share = 0;
   /// Pairs of `watertight`'s faces that cross (FindSelfIntersections): Poisson can fold its
   /// surface through itself, and such a mesh is closed and manifold but not watertight.
   std::int64_t self_intersections = 0;
@@ -80,9 +89,12 @@ struct MeshingResult {
   double cleanup_ms = 0;
   double smoothing_ms = 0;
   double poisson_ms = 0;
+  double bound_ms = 0;
 };
 
-/// Runs the steps above on a raw marching-cubes mesh.
-MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options = {});
+/// Runs the steps above on a raw marching-cubes mesh; with `free_space`, Poisson's mesh is
+/// bounded by its views.
+MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options = {},
+                         const FreeSpace* free_space = nullptr);
 
 }  // namespace ihs::fusion

@@ -1,16 +1,14 @@
 #include "fusion/tsdf_volume.h"
 
-#include <pcl/surface/marching_cubes.h>  // The marching-cubes case tables (edgeTable, triTable).
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 #include "core/check.h"
+#include "fusion/marching_cubes.h"
 
 namespace ihs::fusion {
 namespace {
@@ -19,12 +17,6 @@ constexpr float kTsdfScale = 32767.0f;
 
 // The nearest integer, halves away from zero: std::lround without its library call.
 inline int RoundToInt(float x) { return static_cast<int>(x >= 0 ? x + 0.5f : x - 0.5f); }
-
-// Cell corners (as offsets) and edges (as corner pairs) in the order of the case tables.
-constexpr int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
-                               {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
-constexpr int kEdge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
-                              {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 
 }  // namespace
 
@@ -343,64 +335,28 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
 
 TriangleMesh TsdfVolume::ExtractMesh() const {
   TriangleMesh mesh;
-  std::unordered_map<std::int64_t, std::int32_t> vertex_of_edge;
   const bool color = options_.color;
-  for (int k = 0; k + 1 < n_; ++k) {
-    for (int j = 0; j + 1 < n_; ++j) {
-      for (int i = 0; i + 1 < n_; ++i) {
-        float value[8];
-        const Voxel* corner[8];
-        int case_index = 0;
-        bool observed = true;
-        for (int c = 0; c < 8 && observed; ++c) {
-          corner[c] = &voxels_[Index(i + kCorner[c][0], j + kCorner[c][1], k + kCorner[c][2])];
-          observed = corner[c]->weight > 0;
-          value[c] = corner[c]->tsdf;
-          if (value[c] < 0) case_index |= 1 << c;
-        }
-        if (!observed || pcl::edgeTable[case_index] == 0) continue;
-        std::int32_t edge_vertex[12];
-        for (int e = 0; e < 12; ++e) {
-          if (!(pcl::edgeTable[case_index] & (1u << e))) continue;
-          const int a = kEdge[e][0], b = kEdge[e][1];
-          // The edge's key: its lower corner's voxel and its axis.
-          int axis = 0;
-          while (kCorner[a][axis] == kCorner[b][axis]) ++axis;
-          const int li = i + std::min(kCorner[a][0], kCorner[b][0]);
-          const int lj = j + std::min(kCorner[a][1], kCorner[b][1]);
-          const int lk = k + std::min(kCorner[a][2], kCorner[b][2]);
-          const std::int64_t key = Index(li, lj, lk) * 3 + axis;
-          const auto found = vertex_of_edge.find(key);
-          if (found != vertex_of_edge.end()) {
-            edge_vertex[e] = found->second;
-            continue;
-          }
-          const float s = value[a] / (value[a] - value[b]);
-          const Eigen::Vector3f pa =
-              Centre(i + kCorner[a][0], j + kCorner[a][1], k + kCorner[a][2]);
-          const Eigen::Vector3f pb =
-              Centre(i + kCorner[b][0], j + kCorner[b][1], k + kCorner[b][2]);
-          mesh.vertices.push_back(pa + s * (pb - pa));
-          if (color) {
-            TriangleMesh::Color rgb;
-            for (int c = 0; c < 3; ++c) {
-              rgb[c] = static_cast<std::uint8_t>(
-                  std::lround(corner[a]->rgb[c] + s * (corner[b]->rgb[c] - corner[a]->rgb[c])));
-            }
-            mesh.colors.push_back(rgb);
-          }
-          edge_vertex[e] = static_cast<std::int32_t>(mesh.vertices.size() - 1);
-          vertex_of_edge.emplace(key, edge_vertex[e]);
-        }
-        for (int t = 0; pcl::triTable[case_index][t] != -1; t += 3) {
-          // The tables wind triangles clockwise seen from outside (positive distance): reversed.
-          mesh.faces.push_back({edge_vertex[pcl::triTable[case_index][t]],
-                                edge_vertex[pcl::triTable[case_index][t + 2]],
-                                edge_vertex[pcl::triTable[case_index][t + 1]]});
-        }
+  auto value = [&](int i, int j, int k, float* sample) {
+    const Voxel& voxel = voxels_[Index(i, j, k)];
+    *sample = voxel.tsdf;
+    return voxel.weight > 0;
+  };
+  auto add_vertex = [&](const LatticePoint& a, const LatticePoint& b, float s) {
+    const Eigen::Vector3f pa = Centre(a[0], a[1], a[2]);
+    const Eigen::Vector3f pb = Centre(b[0], b[1], b[2]);
+    mesh.vertices.push_back(pa + s * (pb - pa));
+    if (color) {
+      const Voxel& va = voxels_[Index(a[0], a[1], a[2])];
+      const Voxel& vb = voxels_[Index(b[0], b[1], b[2])];
+      TriangleMesh::Color rgb;
+      for (int c = 0; c < 3; ++c) {
+        rgb[c] = static_cast<std::uint8_t>(std::lround(va.rgb[c] + s * (vb.rgb[c] - va.rgb[c])));
       }
+      mesh.colors.push_back(rgb);
     }
-  }
+    return static_cast<std::int32_t>(mesh.vertices.size() - 1);
+  };
+  MarchingCubes({n_, n_, n_}, value, add_vertex, &mesh.faces);
   mesh.ComputeVertexNormals();
   return mesh;
 }

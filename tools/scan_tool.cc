@@ -116,9 +116,9 @@ int Run(const Args& args) {
 
   // Meshes.
   auto start = ihs::SteadyClock::now();
-  const ihs::TriangleMesh raw = object_stage.Snapshot();
+  const ihs::fusion::ModelSnapshot model = object_stage.Snapshot();
   const double marching_cubes_ms = ihs::MillisecondsSince(start);
-  const ihs::app::ExportedMeshes exported = ihs::app::ExportMeshes(raw, options.meshing, out);
+  const ihs::app::ExportedMeshes exported = ihs::app::ExportMeshes(model, options.meshing, out);
   const double export_ms = ihs::MillisecondsSince(start);
   const fusion::MeshingResult& meshes = exported.meshes;
   if (exported.files.empty()) {
@@ -141,11 +141,14 @@ int Run(const Args& args) {
         {"marching_cubes", marching_cubes_ms},
         {"cleanup", meshes.cleanup_ms},
         {"smoothing", meshes.smoothing_ms},
-        {"poisson", meshes.poisson_ms}}},
+        {"poisson", meshes.poisson_ms},
+        {"bound", meshes.bound_ms}}},
       {"mesh",
        {{"faces", meshes.watertight.faces.size()},
         {"watertight", meshes.IsWatertight()},
         {"self_intersections", meshes.self_intersections},
+        {"unseen_share", meshes.unseen_share},
+        {"cut_share", meshes.cut_share},
         {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
 
   auto count = [](const nlohmann::json& counts, const char* key) {
@@ -165,9 +168,11 @@ int Run(const Args& args) {
       "raycast %.1f, ICP %.1f, integrate %.1f)\n",
       mean("track"), mean("mask"), mean("features"), mean("fusion"), mean("pairwise"),
       mean("raycast"), mean("icp"), mean("integrate"));
-  std::printf("export: %.0f ms (marching cubes %.0f, cleanup %.0f, smoothing %.0f, Poisson %.0f)\n",
-              export_ms, marching_cubes_ms, meshes.cleanup_ms, meshes.smoothing_ms,
-              meshes.poisson_ms);
+  std::printf(
+      "export: %.0f ms (marching cubes %.0f, cleanup %.0f, smoothing %.0f, Poisson %.0f, bound "
+      "%.0f)\n",
+      export_ms, marching_cubes_ms, meshes.cleanup_ms, meshes.smoothing_ms, meshes.poisson_ms,
+      meshes.bound_ms);
   std::printf("mesh: %s (%zu faces, %s)\n", (out / "mesh.ply").c_str(),
               meshes.watertight.faces.size(),
               meshes.IsWatertight()                 ? "watertight"
@@ -176,6 +181,10 @@ int Run(const Args& args) {
   std::printf("coverage: seen from %.1f %% of the directions around it, %.1f %% of the "
               "watertight mesh never seen\n",
               100 * record.coverage(), 100 * meshes.unseen_share);
+  if (meshes.cut_share > 0) {
+    std::printf("closure: %.1f %% of Poisson's volume cut away where the views saw empty space\n",
+                100 * meshes.cut_share);
+  }
 
   if (!args.gt.empty()) {
     // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's

@@ -114,11 +114,11 @@ app::ScannerOptions OptionsFor(const Method& method) {
   return options;
 }
 
-// Meshes and measures of one method from its raw marching-cubes mesh.
-void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const TriangleMesh& raw,
+// Meshes and measures of one method from its model (raw mesh and free space).
+void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const fusion::ModelSnapshot& model,
                     const fusion::MeshingOptions& meshing, MethodResult& result) {
   const auto start = SteadyClock::now();
-  fusion::MeshingResult meshes = fusion::MakeMeshes(raw, meshing);
+  fusion::MeshingResult meshes = fusion::MakeMeshes(model.raw, meshing, &model.free_space);
   result.measures["export_ms"] = MillisecondsSince(start);
   result.measures["poisson_ms"] = meshes.poisson_ms;
   const std::string object = c.object == "box" ? "" : c.object;
@@ -226,9 +226,9 @@ CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
         const eval::TrajectoryError drift = eval::CompareTrajectory(out.gt_dir, result.trajectory);
         result.measures["trajectory_error_mm"] = {{"mean", drift.mean_mm}, {"max", drift.max_mm}};
       } else {
-        const TriangleMesh raw = runner.stage->Snapshot();
+        const fusion::ModelSnapshot model = runner.stage->Snapshot();
         runner.stage.reset();  // The volume's memory, before Poisson needs its own.
-        MeshAndMeasure(c, out.gt_dir, raw, runner.options.meshing, result);
+        MeshAndMeasure(c, out.gt_dir, model, runner.options.meshing, result);
       }
       result.ok = true;
     } catch (const std::exception& error) {
@@ -252,7 +252,9 @@ CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
                                          {"fusion", o3d.odometry_ms + o3d.integrate_ms}};
       result.measures["odometry_failures"] = o3d.odometry_failures;
       if (result.trajectory.empty()) throw InputError("no frame was registered");
-      MeshAndMeasure(c, out.gt_dir, o3d.raw, base.meshing, result);
+      // Open3D's baseline keeps no free-space views: its closure is Poisson's alone.
+      MeshAndMeasure(c, out.gt_dir, {std::move(o3d.raw), fusion::FreeSpace()}, base.meshing,
+                     result);
       result.ok = true;
     } catch (const std::exception& error) {
       result.error = error.what();

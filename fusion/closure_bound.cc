@@ -1,0 +1,226 @@
+#include "fusion/closure_bound.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/check.h"
+#include "core/point_kd_tree.h"
+#include "fusion/marching_cubes.h"
+#include "fusion/surface_mesh.h"
+#include "fusion/triangle_cover.h"
+
+namespace ihs::fusion {
+namespace {
+
+// A lattice of points `step` apart from `origin`.
+struct Lattice {
+  Eigen::Vector3f origin;
+  float step = 1;
+  LatticePoint size = {0, 0, 0};
+
+  std::int64_t Index(int i, int j, int k) const {
+    return (static_cast<std::int64_t>(k) * size[1] + j) * size[0] + i;
+  }
+  std::int64_t Count() const { return Index(0, 0, size[2]); }
+  Eigen::Vector3f Point(int i, int j, int k) const {
+    return origin + step * Eigen::Vector3f(static_cast<float>(i), static_cast<float>(j),
+                                           static_cast<float>(k));
+  }
+  // The lattice range [lo, hi] of coordinate `axis` covering [a, b], clamped.
+  void Range(int axis, float a, float b, int* lo, int* hi) const {
+    *lo = std::max(0, static_cast<int>(std::ceil((a - origin[axis]) / step)));
+    *hi = std::min(size[axis] - 1, static_cast<int>(std::floor((b - origin[axis]) / step)));
+  }
+};
+
+// Squared distance from p to triangle abc (closest point by the triangle's Voronoi regions,
+// as in Ericson's Real-Time Collision Detection, 5.1.5).
+float DistanceSqToTriangle(const Eigen::Vector3f& p, const Eigen::Vector3f& a,
+                           const Eigen::Vector3f& b, const Eigen::Vector3f& c) {
+  const Eigen::Vector3f ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
+  const Eigen::Vector3f bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - d1 / (d1 - d3) * ab).squaredNorm();
+  const Eigen::Vector3f cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - d2 / (d2 - d6) * ac).squaredNorm();
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return (bp - (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)).squaredNorm();
+  }
+  const float denominator = 1.0f / (va + vb + vc);
+  return (ap - (vb * denominator) * ab - (vc * denominator) * ac).squaredNorm();
+}
+
+// Per lattice point: −1 inside `mesh` (watertight), +1 outside, by the parity of the faces
+// crossed along z below the point.
+std::vector<std::int8_t> InsideSign(const TriangleMesh& mesh, const Lattice& lattice) {
+  std::vector<std::vector<float>> crossings(static_cast<size_t>(lattice.size[0]) *
+                                            lattice.size[1]);
+  for (const auto& face : mesh.faces) {
+    Eigen::Vector3d corner[3];
+    for (int c = 0; c < 3; ++c) corner[c] = mesh.vertices[face[c]].cast<double>();
+    Eigen::Vector2d q[3] = {corner[0].head<2>(), corner[1].head<2>(), corner[2].head<2>()};
+    double area = TwiceSignedArea(q);
+    if (area == 0) continue;  // Seen edge-on from z: no column crosses it alone.
+    if (area < 0) {
+      std::swap(q[1], q[2]);
+      std::swap(corner[1], corner[2]);
+      area = -area;
+    }
+    int i0, i1, j0, j1;
+    lattice.Range(0, static_cast<float>(std::min({q[0].x(), q[1].x(), q[2].x()})),
+                  static_cast<float>(std::max({q[0].x(), q[1].x(), q[2].x()})), &i0, &i1);
+    lattice.Range(1, static_cast<float>(std::min({q[0].y(), q[1].y(), q[2].y()})),
+                  static_cast<float>(std::max({q[0].y(), q[1].y(), q[2].y()})), &j0, &j1);
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        const Eigen::Vector2d p = lattice.Point(i, j, 0).head<2>().cast<double>();
+        double w[3];
+        if (!CoversPoint(q, p, w)) continue;
+        const double z = (w[0] * corner[0].z() + w[1] * corner[1].z() + w[2] * corner[2].z()) / area;
+        crossings[static_cast<size_t>(j) * lattice.size[0] + i].push_back(static_cast<float>(z));
+      }
+    }
+  }
+  std::vector<std::int8_t> sign(static_cast<size_t>(lattice.Count()), 1);
+  for (int j = 0; j < lattice.size[1]; ++j) {
+    for (int i = 0; i < lattice.size[0]; ++i) {
+      std::vector<float>& column = crossings[static_cast<size_t>(j) * lattice.size[0] + i];
+      std::sort(column.begin(), column.end());
+      size_t below = 0;
+      for (int k = 0; k < lattice.size[2]; ++k) {
+        const float z = lattice.Point(i, j, k).z();
+        while (below < column.size() && column[below] < z) ++below;
+        if (below % 2 == 1) sign[lattice.Index(i, j, k)] = -1;
+      }
+    }
+  }
+  return sign;
+}
+
+// The signed distance to `mesh` (negative inside) at every lattice point, its magnitude
+// clamped to `band`.
+std::vector<float> SignedDistance(const TriangleMesh& mesh, const Lattice& lattice, float band) {
+  std::vector<float> distance(static_cast<size_t>(lattice.Count()), band * band);
+  for (const auto& face : mesh.faces) {
+    const Eigen::Vector3f& a = mesh.vertices[face[0]];
+    const Eigen::Vector3f& b = mesh.vertices[face[1]];
+    const Eigen::Vector3f& c = mesh.vertices[face[2]];
+    const Eigen::Vector3f lo = a.cwiseMin(b).cwiseMin(c).array() - band;
+    const Eigen::Vector3f hi = a.cwiseMax(b).cwiseMax(c).array() + band;
+    int range[3][2];
+    for (int axis = 0; axis < 3; ++axis) {
+      lattice.Range(axis, lo[axis], hi[axis], &range[axis][0], &range[axis][1]);
+    }
+    for (int k = range[2][0]; k <= range[2][1]; ++k) {
+      for (int j = range[1][0]; j <= range[1][1]; ++j) {
+        for (int i = range[0][0]; i <= range[0][1]; ++i) {
+          float& d = distance[lattice.Index(i, j, k)];
+          d = std::min(d, DistanceSqToTriangle(lattice.Point(i, j, k), a, b, c));
+        }
+      }
+    }
+  }
+  const std::vector<std::int8_t> sign = InsideSign(mesh, lattice);
+  for (size_t n = 0; n < distance.size(); ++n) distance[n] = sign[n] * std::sqrt(distance[n]);
+  return distance;
+}
+
+}  // namespace
+
+ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& seen,
+                              const FreeSpace& free_space, double voxel_mm, double keep_seen_mm,
+                              double min_component_fraction) {
+  IHS_CHECK_ARG(voxel_mm > 0, "the bound's voxel must be positive, got " << voxel_mm);
+  ClosureBound result;
+  result.mesh = closed;
+  if (closed.faces.empty() || free_space.views() == 0) return result;
+  // Space seen empty inside the closed mesh is seen through its surface on the way there: when
+  // none of its vertices (away from the seen surface) is empty, nothing is cut.
+  const PointKdTree seen_tree(seen.vertices);
+  const float keep_sq = static_cast<float>(keep_seen_mm * keep_seen_mm);
+  auto near_seen = [&](const Eigen::Vector3f& point) {
+    float distance_sq = 0;
+    return !seen.vertices.empty() && seen_tree.Nearest(point, &distance_sq) >= 0 &&
+           distance_sq < keep_sq;
+  };
+  const bool any_empty = std::any_of(closed.vertices.begin(), closed.vertices.end(),
+                                     [&](const Eigen::Vector3f& vertex) {
+                                       return free_space.Emptiness(vertex, 1.0f) > 0 &&
+                                              !near_seen(vertex);
+                                     });
+  if (!any_empty) return result;
+
+  // A lattice over the closed mesh with two steps of room on every side (all outside).
+  Eigen::Vector3f lo = closed.vertices[0], hi = closed.vertices[0];
+  for (const auto& v : closed.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  Lattice lattice;
+  lattice.step = static_cast<float>(voxel_mm);
+  lattice.origin = lo.array() - 2 * lattice.step;
+  for (int axis = 0; axis < 3; ++axis) {
+    lattice.size[axis] = static_cast<int>(std::ceil((hi[axis] - lo[axis]) / lattice.step)) + 5;
+  }
+  // Distances beyond 1.5 steps never place a vertex; the emptiness is clamped alike.
+  const float band = 1.5f * lattice.step;
+  std::vector<float> field = SignedDistance(closed, lattice, band);
+
+  // Points inside (or next to) the closed mesh that the views saw empty move outside, unless
+  // they are near the seen surface.
+  bool cut_inside = false;
+  for (int k = 0; k < lattice.size[2]; ++k) {
+    for (int j = 0; j < lattice.size[1]; ++j) {
+      for (int i = 0; i < lattice.size[0]; ++i) {
+        float& value = field[lattice.Index(i, j, k)];
+        if (value >= band) continue;
+        const Eigen::Vector3f point = lattice.Point(i, j, k);
+        const float empty = free_space.Emptiness(point, band);
+        if (empty <= value || near_seen(point)) continue;
+        if (value < 0 && empty > 0) cut_inside = true;
+        value = empty;
+      }
+    }
+  }
+  if (!cut_inside) return result;
+
+  TriangleMesh bounded;
+  auto value = [&](int i, int j, int k, float* sample) {
+    *sample = field[lattice.Index(i, j, k)];
+    return true;
+  };
+  auto add_vertex = [&](const LatticePoint& a, const LatticePoint& b, float s) {
+    const Eigen::Vector3f pa = lattice.Point(a[0], a[1], a[2]);
+    const Eigen::Vector3f pb = lattice.Point(b[0], b[1], b[2]);
+    bounded.vertices.push_back(pa + s * (pb - pa));
+    return static_cast<std::int32_t>(bounded.vertices.size() - 1);
+  };
+  MarchingCubes(lattice.size, value, add_vertex, &bounded.faces);
+  bounded = RemoveSmallComponents(bounded, min_component_fraction);
+  bounded.ComputeVertexNormals();
+  if (closed.HasColors() && !bounded.Empty()) {
+    const PointKdTree tree(closed.vertices);
+    bounded.colors.resize(bounded.vertices.size());
+    for (size_t n = 0; n < bounded.vertices.size(); ++n) {
+      float distance_sq = 0;
+      bounded.colors[n] = closed.colors[tree.Nearest(bounded.vertices[n], &distance_sq)];
+    }
+  }
+  const double volume = closed.Volume();
+  result.removed_share = volume > 0 ? std::max(0.0, 1.0 - bounded.Volume() / volume) : 0.0;
+  result.mesh = std::move(bounded);
+  result.changed = true;
+  return result;
+}
+
+}  // namespace ihs::fusion
