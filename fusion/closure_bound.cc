@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -24,6 +25,24 @@ struct Lattice {
     return (static_cast<std::int64_t>(k) * size[1] + j) * size[0] + i;
   }
   std::int64_t Count() const { return Index(0, 0, size[2]); }
+  // The point of index `n`.
+  Eigen::Vector3f Point(std::int64_t n) const {
+    const auto [i, j, k] = Coordinates(n);
+    return Point(i, j, k);
+  }
+  std::array<int, 3> Coordinates(std::int64_t n) const {
+    const int i = static_cast<int>(n % size[0]);
+    const int j = static_cast<int>((n / size[0]) % size[1]);
+    return {i, j, static_cast<int>(n / (static_cast<std::int64_t>(size[0]) * size[1]))};
+  }
+  // The indices of the six neighbours of point `n` (−1 past the lattice's faces).
+  std::array<std::int64_t, 6> Neighbours(std::int64_t n) const {
+    const auto [i, j, k] = Coordinates(n);
+    const std::int64_t row = size[0], slice = static_cast<std::int64_t>(size[0]) * size[1];
+    return {i > 0 ? n - 1 : -1,         i + 1 < size[0] ? n + 1 : -1,
+            j > 0 ? n - row : -1,       j + 1 < size[1] ? n + row : -1,
+            k > 0 ? n - slice : -1,     k + 1 < size[2] ? n + slice : -1};
+  }
   Eigen::Vector3f Point(int i, int j, int k) const {
     return origin + step * Eigen::Vector3f(static_cast<float>(i), static_cast<float>(j),
                                            static_cast<float>(k));
@@ -144,8 +163,10 @@ ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& se
   ClosureBound result;
   result.mesh = closed;
   if (closed.faces.empty() || free_space.views() == 0) return result;
+  const float step = static_cast<float>(voxel_mm);
   // Space seen empty inside the closed mesh is seen through its surface on the way there: when
-  // none of its vertices (away from the seen surface) is empty, nothing is cut.
+  // none of its vertices (away from the seen surface) lies deeper than a lattice step in empty
+  // space, nothing is cut (a step is what the lattice could place a cut to).
   const PointKdTree seen_tree(seen.vertices);
   const float keep_sq = static_cast<float>(keep_seen_mm * keep_seen_mm);
   auto near_seen = [&](const Eigen::Vector3f& point) {
@@ -155,7 +176,7 @@ ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& se
   };
   const bool any_empty = std::any_of(closed.vertices.begin(), closed.vertices.end(),
                                      [&](const Eigen::Vector3f& vertex) {
-                                       return free_space.Emptiness(vertex, 1.0f) > 0 &&
+                                       return free_space.Emptiness(vertex, 2 * step) > step &&
                                               !near_seen(vertex);
                                      });
   if (!any_empty) return result;
@@ -167,7 +188,7 @@ ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& se
     hi = hi.cwiseMax(v);
   }
   Lattice lattice;
-  lattice.step = static_cast<float>(voxel_mm);
+  lattice.step = step;
   lattice.origin = lo.array() - 2 * lattice.step;
   for (int axis = 0; axis < 3; ++axis) {
     lattice.size[axis] = static_cast<int>(std::ceil((hi[axis] - lo[axis]) / lattice.step)) + 5;
@@ -177,20 +198,38 @@ ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& se
   std::vector<float> field = SignedDistance(closed, lattice, band);
 
   // Points inside (or next to) the closed mesh that the views saw empty move outside, unless
-  // they are near the seen surface.
+  // they are near the seen surface. Carved from the outside in: first the points next to the
+  // surface, then the inside neighbours of those found empty, and so on (space seen empty
+  // inside the mesh was seen through its surface; a deep inside that no empty path reaches is
+  // never evaluated, which keeps a large object's export fast).
+  std::vector<std::uint8_t> visited(field.size(), 0);
+  std::vector<std::int64_t> frontier;
+  for (std::int64_t n = 0; n < lattice.Count(); ++n) {
+    if (std::abs(field[n]) < band) {
+      frontier.push_back(n);
+      visited[n] = 1;
+    }
+  }
   bool cut_inside = false;
-  for (int k = 0; k < lattice.size[2]; ++k) {
-    for (int j = 0; j < lattice.size[1]; ++j) {
-      for (int i = 0; i < lattice.size[0]; ++i) {
-        float& value = field[lattice.Index(i, j, k)];
-        if (value >= band) continue;
-        const Eigen::Vector3f point = lattice.Point(i, j, k);
-        const float empty = free_space.Emptiness(point, band);
-        if (empty <= value || near_seen(point)) continue;
-        if (value < 0 && empty > 0) cut_inside = true;
-        value = empty;
+  std::vector<Eigen::Vector3f> points;
+  while (!frontier.empty()) {
+    points.clear();
+    for (const std::int64_t n : frontier) points.push_back(lattice.Point(n));
+    const std::vector<float> emptiness = free_space.Emptiness(points, band);
+    std::vector<std::int64_t> next;
+    for (size_t f = 0; f < frontier.size(); ++f) {
+      float& value = field[frontier[f]];
+      if (emptiness[f] <= value || near_seen(points[f])) continue;
+      if (value < 0 && emptiness[f] > 0) cut_inside = true;
+      value = emptiness[f];
+      if (emptiness[f] <= 0) continue;
+      for (const std::int64_t neighbour : lattice.Neighbours(frontier[f])) {
+        if (neighbour < 0 || visited[neighbour] || field[neighbour] >= band) continue;
+        visited[neighbour] = 1;
+        next.push_back(neighbour);
       }
     }
+    frontier = std::move(next);
   }
   if (!cut_inside) return result;
 

@@ -183,46 +183,77 @@ bool FreeSpace::Observe(const Frame& frame, const std::array<int, 4>& object_box
   return true;
 }
 
+// The votes of the views on one point so far.
+struct FreeSpace::Tally {
+  // The k largest signed distances in front of the measured depth (or inside the hand),
+  // descending.
+  float top[kMaxMinViews];
+  int kept = 0;
+  EmptinessVotes votes;
+};
+
+void FreeSpace::Vote(const DepthView& view, const Eigen::Vector3f& point, float limit,
+                     Tally* tally) const {
+  const Eigen::Vector3f p = view.rotation * point + view.translation;
+  if (p.z() <= 1.0f) return;
+  // Rounded to the nearest pixel (std::lround is a library call; this runs millions of times).
+  const float column = static_cast<float>(intrinsics_.fx) * p.x() / p.z() +
+                       static_cast<float>(intrinsics_.cx) - view.u0 + 0.5f;
+  const float row = static_cast<float>(intrinsics_.fy) * p.y() / p.z() +
+                    static_cast<float>(intrinsics_.cy) - view.v0 + 0.5f;
+  if (!(column >= 0 && row >= 0 && column < view.width && row < view.height)) return;
+  const int u = static_cast<int>(column), v = static_cast<int>(row);
+  const float margin = static_cast<float>(options_.margin_mm);
+  const std::uint16_t depth = view.depth_mm[static_cast<size_t>(v) * view.width + u];
+  float in_front =
+      depth == DepthView::kNothing ? limit : static_cast<float>(depth) - p.z() - margin;
+  const float inside_hand = view.DepthInsideHand(u, v, p.z()) - margin;
+  in_front = std::max(in_front, inside_hand);
+  if (depth == 0 && in_front <= 0) return;  // No evidence either way.
+  if (in_front > 0) {
+    ++tally->votes.through;
+    if (inside_hand > 0) ++tally->votes.in_hand;
+  } else if (in_front >= -2 * margin) {
+    ++tally->votes.at_surface;  // Within the margin of the measured depth, on either side.
+  }
+  // Insert into the descending top k.
+  const int k = options_.min_views;
+  int slot = std::min(tally->kept, k - 1);
+  if (tally->kept < k) {
+    ++tally->kept;
+  } else if (in_front <= tally->top[slot]) {
+    return;
+  }
+  while (slot > 0 && tally->top[slot - 1] < in_front) {
+    tally->top[slot] = tally->top[slot - 1];
+    --slot;
+  }
+  tally->top[slot] = in_front;
+}
+
+float FreeSpace::Result(const Tally& tally, float limit) const {
+  const int k = options_.min_views;
+  if (tally.kept < k || tally.votes.through <= tally.votes.at_surface) return -limit;
+  return std::clamp(tally.top[k - 1], -limit, limit);
+}
+
 float FreeSpace::Emptiness(const Eigen::Vector3f& point, float limit,
                            EmptinessVotes* votes) const {
-  const int k = options_.min_views;
-  const float margin = static_cast<float>(options_.margin_mm);
-  // The k largest signed distances in front of the measured depth, descending.
-  float top[kMaxMinViews];
-  int kept = 0, through = 0, in_hand = 0, at_surface = 0;
-  const float fx = static_cast<float>(intrinsics_.fx), fy = static_cast<float>(intrinsics_.fy);
-  const float cx = static_cast<float>(intrinsics_.cx), cy = static_cast<float>(intrinsics_.cy);
+  Tally tally;
+  for (const auto& view : views_) Vote(*view, point, limit, &tally);
+  if (votes != nullptr) *votes = tally.votes;
+  return Result(tally, limit);
+}
+
+std::vector<float> FreeSpace::Emptiness(const std::vector<Eigen::Vector3f>& points,
+                                        float limit) const {
+  std::vector<Tally> tallies(points.size());
   for (const auto& view : views_) {
-    const Eigen::Vector3f p = view->rotation * point + view->translation;
-    if (p.z() <= 1.0f) continue;
-    const int u = static_cast<int>(std::lround(fx * p.x() / p.z() + cx)) - view->u0;
-    const int v = static_cast<int>(std::lround(fy * p.y() / p.z() + cy)) - view->v0;
-    if (u < 0 || v < 0 || u >= view->width || v >= view->height) continue;
-    const std::uint16_t depth = view->depth_mm[static_cast<size_t>(v) * view->width + u];
-    float in_front =
-        depth == DepthView::kNothing ? limit : static_cast<float>(depth) - p.z() - margin;
-    const float inside_hand = view->DepthInsideHand(u, v, p.z()) - margin;
-    in_front = std::max(in_front, inside_hand);
-    if (depth == 0 && in_front <= 0) continue;  // No evidence either way.
-    if (in_front > 0) {
-      ++through;
-      if (inside_hand > 0) ++in_hand;
-    } else if (in_front >= -2 * margin) {
-      ++at_surface;  // Within the margin of the measured depth, on either side.
-    }
-    // Insert into the descending top k.
-    int slot = std::min(kept, k - 1);
-    if (kept < k) ++kept;
-    else if (in_front <= top[slot]) continue;
-    while (slot > 0 && top[slot - 1] < in_front) {
-      top[slot] = top[slot - 1];
-      --slot;
-    }
-    top[slot] = in_front;
+    for (size_t n = 0; n < points.size(); ++n) Vote(*view, points[n], limit, &tallies[n]);
   }
-  if (votes != nullptr) *votes = {through, in_hand, at_surface};
-  if (kept < k || through <= at_surface) return -limit;
-  return std::clamp(top[k - 1], -limit, limit);
+  std::vector<float> emptiness(points.size());
+  for (size_t n = 0; n < points.size(); ++n) emptiness[n] = Result(tallies[n], limit);
+  return emptiness;
 }
 
 }  // namespace ihs::fusion

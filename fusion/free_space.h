@@ -113,11 +113,20 @@ class FreeSpace {
   /// elsewhere.
   float Emptiness(const Eigen::Vector3f& point, float limit,
                   EmptinessVotes* votes = nullptr) const;
+  /// The same for many points, one view at a time (faster for many: each view's depth stays in
+  /// the cache).
+  std::vector<float> Emptiness(const std::vector<Eigen::Vector3f>& points, float limit) const;
 
   int views() const { return static_cast<int>(views_.size()); }
   const FreeSpaceOptions& options() const { return options_; }
 
  private:
+  struct Tally;
+  // Adds `view`'s vote on `point` (object frame) to `tally`.
+  void Vote(const DepthView& view, const Eigen::Vector3f& point, float limit, Tally* tally) const;
+  // The emptiness the votes give.
+  float Result(const Tally& tally, float limit) const;
+
   CameraIntrinsics intrinsics_;
   FreeSpaceOptions options_;
   std::vector<std::shared_ptr<const DepthView>> views_;
