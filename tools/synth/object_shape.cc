@@ -10,12 +10,16 @@ namespace {
 
 constexpr int kLatheSegments = 180;
 
+// In scalars: the grasp planner asks millions of times, and unoptimised (sanitizer) builds do
+// not inline Eigen's small-vector temporaries.
 double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
                        const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double length2 = ab.squaredNorm();
-  const double s = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-  return (p - (a + s * ab)).norm();
+  const double abx = b.x() - a.x(), aby = b.y() - a.y();
+  const double apx = p.x() - a.x(), apy = p.y() - a.y();
+  const double length2 = abx * abx + aby * aby;
+  const double s = length2 > 0 ? std::clamp((apx * abx + apy * aby) / length2, 0.0, 1.0) : 0.0;
+  const double dx = p.x() - (a.x() + s * abx), dy = p.y() - (a.y() + s * aby);
+  return std::sqrt(dx * dx + dy * dy);
 }
 
 }  // namespace
@@ -68,6 +72,10 @@ ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& prof
   }
   shape.outline_.emplace_back(0.0, profile.back().first);
   for (const Eigen::Vector2d& point : shape.outline_) shape.outline_z_.push_back(point.y());
+  for (size_t i = 0; i + 1 < shape.outline_.size(); ++i) {
+    const double a = shape.outline_[i].x(), b = shape.outline_[i + 1].x();
+    shape.segment_r_.push_back({std::min(a, b), std::max(a, b)});
+  }
   return shape;
 }
 
@@ -103,11 +111,16 @@ double ObjectShape::SignedDistance(const Eigen::Vector3d& p) const {
   const auto level = std::upper_bound(outline_z_.begin(), outline_z_.end(), q.y());
   // The segment whose height range holds q (z_i <= q.z < z_i+1), clamped to the outline's.
   const int at = std::clamp(static_cast<int>(level - outline_z_.begin()) - 1, 0, segments - 1);
+  // A segment is also at least its radius gap from the point: segments farther by that bound
+  // than the nearest found are skipped without their square root (most, for the hand's points
+  // far from the object).
   double distance = std::numeric_limits<double>::infinity();
-  for (int i = at; i < segments && outline_z_[i] - q.y() < distance; ++i)
-    distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
-  for (int i = at - 1; i >= 0 && q.y() - outline_z_[i + 1] < distance; --i)
-    distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
+  auto visit = [&](int i) {
+    const double gap = std::max({0.0, q.x() - segment_r_[i][1], segment_r_[i][0] - q.x()});
+    if (gap < distance) distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
+  };
+  for (int i = at; i < segments && outline_z_[i] - q.y() < distance; ++i) visit(i);
+  for (int i = at - 1; i >= 0 && q.y() - outline_z_[i + 1] < distance; --i) visit(i);
   // Inside: a ray toward +r crosses the closed polygon once, at the segment that spans q's
   // height (the axis segment, at r = 0, never: q's r is not negative).
   bool inside = false;

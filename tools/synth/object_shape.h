@@ -4,6 +4,7 @@
 // close fingers onto it, to decide which fingertips touch it and to measure penetration.
 
 #include <Eigen/Core>
+#include <array>
 #include <string>
 
 #include "core/triangle_mesh.h"
@@ -58,6 +59,8 @@ class ObjectShape {
   // Closed profile polygon in the (r, z) half-plane, from the bottom axis point to the top one.
   std::vector<Eigen::Vector2d> outline_;
   std::vector<double> outline_z_;  // Its heights, which never decrease.
+  // Each outline segment's radius range (lowest, highest).
+  std::vector<std::array<double, 2>> segment_r_;
 };
 
 }  // namespace ihs::synth
