@@ -31,12 +31,12 @@ std::vector<Frame> MakePatternFrames(int count, int width, int height) {
 
 namespace {
 // The ray parameter (camera frame, unit ray) where pixel (u, v)'s ray first meets the ellipsoid,
-// or a negative value on a miss.
-double EllipsoidHit(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object,
+// or a negative value on a miss. The caller inverts the pose once per frame (per pixel, it was
+// most of the AddressSanitizer stage's fusion tests).
+double EllipsoidHit(const CameraIntrinsics& intrinsics, const Rigid3& object_from_cam,
                     const Eigen::Vector3d& semi_axes_mm, double u, double v,
                     Eigen::Vector3d* ray_out) {
   const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
-  const Rigid3 object_from_cam = cam_from_object.Inverse();
   // In the frame where the ellipsoid is the unit sphere.
   const Eigen::Vector3d origin = object_from_cam.translation().cwiseQuotient(semi_axes_mm);
   const Eigen::Vector3d direction = object_from_cam.RotateVector(ray).cwiseQuotient(semi_axes_mm);
@@ -51,7 +51,7 @@ double EllipsoidHit(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_o
 double EllipsoidDepth(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object,
                       const Eigen::Vector3d& semi_axes_mm, double u, double v) {
   Eigen::Vector3d ray;
-  const double t = EllipsoidHit(intrinsics, cam_from_object, semi_axes_mm, u, v, &ray);
+  const double t = EllipsoidHit(intrinsics, cam_from_object.Inverse(), semi_axes_mm, u, v, &ray);
   return t > 0 ? t * ray.z() : 0.0;
 }
 
@@ -62,7 +62,7 @@ Frame RenderEllipsoid(const CameraIntrinsics& intrinsics, const Rigid3& cam_from
   for (int v = 0; v < frame.height; ++v) {
     for (int u = 0; u < frame.width; ++u) {
       Eigen::Vector3d ray;
-      const double t = EllipsoidHit(intrinsics, cam_from_object, semi_axes_mm, u, v, &ray);
+      const double t = EllipsoidHit(intrinsics, object_from_cam, semi_axes_mm, u, v, &ray);
       if (t <= 0) continue;
       const int pixel = v * frame.width + u;
       frame.depth_mm[pixel] = static_cast<std::uint16_t>(std::lround(t * ray.z()));
