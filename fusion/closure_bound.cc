@@ -15,6 +15,9 @@
 namespace ihs::fusion {
 namespace {
 
+// The most lattice points a bound uses (a 250 mm cube at 1 mm).
+constexpr double kMaxLatticePoints = 16e6;
+
 // A lattice of points `step` apart from `origin`.
 struct Lattice {
   Eigen::Vector3f origin;
@@ -188,7 +191,10 @@ ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& se
     hi = hi.cwiseMax(v);
   }
   Lattice lattice;
-  lattice.step = step;
+  // A coarser step for a closed mesh so large (a scene, not a held object) that the lattice
+  // would pass kMaxLatticePoints (about 100 MB of lattice).
+  const double box_volume = static_cast<double>((hi - lo).array().prod());
+  lattice.step = std::max(step, static_cast<float>(std::cbrt(box_volume / kMaxLatticePoints)));
   lattice.origin = lo.array() - 2 * lattice.step;
   for (int axis = 0; axis < 3; ++axis) {
     lattice.size[axis] = static_cast<int>(std::ceil((hi[axis] - lo[axis]) / lattice.step)) + 5;

@@ -22,7 +22,8 @@ struct ClosureBound {
 
 /// `closed` (watertight, object frame, mm) without the space `free_space` saw empty, except
 /// within `keep_seen_mm` of the vertices of `seen` (the surface frames saw), remeshed on a
-/// lattice of `voxel_mm` when anything is cut; colours come from the nearest vertex of
+/// lattice of `voxel_mm` when anything is cut (coarser when the closed mesh is so large that
+/// the lattice would pass 16 million points: a scene rather than a held object); colours come from the nearest vertex of
 /// `closed`. Pieces with fewer faces than `min_component_fraction` of the largest one's are
 /// dropped (a cut may leave crumbs).
 ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& seen,
