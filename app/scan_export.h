@@ -22,10 +22,11 @@ struct ExportedMeshes {
   double milliseconds = 0;
 };
 
-/// Meshes `model` (its raw mesh, bounded by its free space) with `options` and writes into `folder`: mesh_tsdf.ply (the smoothed surface),
-/// mesh.ply (the watertight mesh; the smoothed one when Poisson is off or gave nothing) and
-/// mesh.<ext> of the same for each of `extra_formats` ("obj", "stl"; "ply" adds nothing). Nothing
-/// is written when the raw mesh has no faces. Throws ihs::OutputError when a file cannot be written.
+/// Meshes `model` (its raw mesh, the closure bounded by its free space) with `options` and
+/// writes into `folder`: mesh_tsdf.ply (the smoothed surface), mesh.ply (the watertight mesh;
+/// the smoothed one when Poisson is off or gave nothing) and mesh.<ext> of the same for each of
+/// `extra_formats` ("obj", "stl"; "ply" adds nothing). Nothing is written when the raw mesh has
+/// no faces. Throws ihs::OutputError when a file cannot be written.
 ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
                             const fusion::MeshingOptions& options,
                             const std::filesystem::path& folder,

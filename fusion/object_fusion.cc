@@ -177,8 +177,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     result.cam_from_object = cam_from_object_;
     const auto integrate_start = SteadyClock::now();
     result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, cam_from_object_);
-    free_space_.Observe(frame, box, cam_from_object_, input.hand);
     result.integrate_ms = MillisecondsSince(integrate_start);
+    free_space_.Observe(frame, box, cam_from_object_, input.hand);
     started_ = true;
     return finish(FusionStatus::kStarted);
   }
@@ -306,8 +306,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   result.cam_from_object = pose;
   const auto integrate_start = SteadyClock::now();
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
-  free_space_.Observe(frame, box, pose, input.hand);
   result.integrate_ms = MillisecondsSince(integrate_start);
+  free_space_.Observe(frame, box, pose, input.hand);
   UpdateAnchors(contact_ids, correspondences.contacts, pose);
   return finish(FusionStatus::kFused);
 }
