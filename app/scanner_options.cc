@@ -62,8 +62,23 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "share of hand points within 10 mm of the model below which the fit is doubtful");
   r.Add("tracker.doubtful_frames_to_search", &t.doubtful_frames_to_search,
         "doubtful frames in a row before searching for the hand anew from the hand cloud");
+  r.Add("tracker.search.directions", &t.search.directions,
+        "a search's directions of the hand's long axis (spread evenly)");
+  r.Add("tracker.search.rolls", &t.search.rolls, "a search's turns about each direction");
+  r.Add("tracker.search.placement_iterations", &t.search.placement_iterations,
+        "rigid ICP iterations placing each search hypothesis on the hand points");
+  r.Add("tracker.search.sample_points", &t.search.sample_points,
+        "model and hand points used to place and score a search hypothesis");
+  r.Add("tracker.search.score_cap_mm", &t.search.score_cap_mm,
+        "largest distance a search hypothesis's score counts per point, mm");
+  r.Add("tracker.search_candidates", &t.search_candidates,
+        "a search's best placed hypotheses that the hand fit tries");
+  r.Add("tracker.search_coarse_iterations", &t.search_coarse_iterations,
+        "correspondence updates for each of a search's hypotheses");
+  r.Add("tracker.search_refined", &t.search_refined,
+        "a search's best hypotheses fitted on after the coarse fits");
   r.Add("tracker.initialisation_iterations", &t.initialisation_iterations,
-        "Levenberg-Marquardt iterations per search hypothesis");
+        "correspondence updates for each refined search hypothesis");
   r.Add("tracker.scale_frames", &t.scale_frames,
         "frames over which the template's scale is estimated (0: none)");
   r.Add("tracker.scale_range", &t.scale_range, "scale candidates span 1 ± this");

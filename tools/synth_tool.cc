@@ -76,6 +76,13 @@ int main(int argc, char** argv) {
   app.add_option("--distance-mm", options.scripted.distance_mm,
                  "object distance from the camera in the scripted motion")
       ->capture_default_str();
+  app.add_option("--tilt-deg", options.scripted.tilt_deg,
+                 "the object's axis leans this much toward the camera (scripted motion)")
+      ->capture_default_str();
+  app.add_option("--start-azimuth-deg", options.scripted.start_azimuth_deg,
+                 "where the hand starts about the object's axis, from the default side "
+                 "position (scripted motion; about 90: the hand in front, its back to the camera)")
+      ->capture_default_str();
   app.add_flag("--no-oni", no_oni, "do not write sequence.oni");
   app.add_flag("--no-tum", no_tum, "do not write the tum/ folder");
   app.add_option("--preset", preset, "demo: 150 frames, procedural hand, sphere")

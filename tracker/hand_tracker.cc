@@ -2,9 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include "core/check.h"
@@ -13,19 +13,6 @@
 
 namespace ihs::tracker {
 namespace {
-
-// Principal axes (columns, by decreasing spread) and centroid of points.
-void PrincipalAxes(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d* centroid,
-                   Eigen::Matrix3d* axes) {
-  *centroid = Eigen::Vector3d::Zero();
-  for (const auto& p : points) *centroid += p;
-  *centroid /= static_cast<double>(points.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const auto& p : points) covariance += (p - *centroid) * (p - *centroid).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-  // Eigen sorts ascending; reverse to largest first.
-  for (int k = 0; k < 3; ++k) axes->col(k) = solver.eigenvectors().col(2 - k);
-}
 
 // How badly a fit explains the hand (lower is better): the data's mean distance, and the shares
 // of data and of visible model points left unexplained (20 mm for none explained).
@@ -61,7 +48,15 @@ void TrackerOptions::Check() const {
   IHS_CHECK_ARG(search_data_coverage >= min_data_coverage && search_data_coverage <= 1,
                 "tracker.search_data_coverage must be in [min_data_coverage, 1]");
   IHS_CHECK_ARG(doubtful_frames_to_search >= 1, "tracker.doubtful_frames_to_search must be >= 1");
-  IHS_CHECK_ARG(initialisation_iterations >= 1, "tracker.initialisation_iterations must be >= 1");
+  IHS_CHECK_ARG(initialisation_iterations >= 1 && initialisation_iterations <= 100,
+                "tracker.initialisation_iterations must be in [1, 100]");
+  IHS_CHECK_ARG(search_coarse_iterations >= 1 && search_coarse_iterations <= 100,
+                "tracker.search_coarse_iterations must be in [1, 100]");
+  search.Check();
+  IHS_CHECK_ARG(search_candidates >= 1 && search_candidates <= 1000,
+                "tracker.search_candidates must be in [1, 1000]");
+  IHS_CHECK_ARG(search_refined >= 1 && search_refined <= 100,
+                "tracker.search_refined must be in [1, 100]");
   IHS_CHECK_ARG(scale_frames >= 0, "tracker.scale_frames must be >= 0");
   IHS_CHECK_ARG(scale_range >= 0 && scale_range < 0.5, "tracker.scale_range must be in [0, 0.5)");
   IHS_CHECK_ARG(scale_step > 0, "tracker.scale_step must be positive");
@@ -76,12 +71,13 @@ HandFitOptions FitOptions(const TrackerOptions& options) {
   return fit;
 }
 
-HandFitOptions InitialFitOptions(const TrackerOptions& options) {
+HandFitOptions InitialFitOptions(const TrackerOptions& options, int iterations) {
   HandFitOptions fit = FitOptions(options);
-  fit.outer_iterations = options.initialisation_iterations;
+  fit.outer_iterations = iterations;
   fit.prior_weight = 0.5;
   return fit;
 }
+
 }  // namespace
 
 // A template scale being tried: the scaled model, its fitter and its summed score.
@@ -119,7 +115,11 @@ HandTracker::~HandTracker() = default;
 
 void HandTracker::BuildStages() {
   fitter_ = std::make_unique<HandFitter>(model_, intrinsics_, FitOptions(options_));
-  initial_fitter_ = std::make_unique<HandFitter>(model_, intrinsics_, InitialFitOptions(options_));
+  search_ = std::make_unique<HandSearch>(model_, intrinsics_, options_.search);
+  coarse_fitter_ = std::make_unique<HandFitter>(
+      model_, intrinsics_, InitialFitOptions(options_, options_.search_coarse_iterations));
+  initial_fitter_ = std::make_unique<HandFitter>(
+      model_, intrinsics_, InitialFitOptions(options_, options_.initialisation_iterations));
   contacts_ = std::make_unique<ContactDetector>(model_, options_.contacts);
 }
 
@@ -181,64 +181,30 @@ void HandTracker::Initialise(const HandPose& pose) {
   has_confident_pose_ = false;
 }
 
-std::vector<HandPose> HandTracker::CloudHypotheses(const std::vector<Eigen::Vector3f>& hand_points,
-                                                   const HandPose& articulation,
-                                                   bool also_unturned) const {
-  // The posed model's principal axes onto the hand cloud's, each way round: the articulation
-  // kept, the whole hand turned and moved onto the cloud.
-  std::vector<Eigen::Vector3d> data, model;
-  for (const auto& p : hand_points) data.push_back(p.cast<double>());
-  for (const auto& v : model_.Pose(ForwardKinematics(model_, articulation)).vertices)
-    model.push_back(v.cast<double>());
-  Eigen::Vector3d data_centre, model_centre;
-  Eigen::Matrix3d data_axes, model_axes;
-  PrincipalAxes(data, &data_centre, &data_axes);
-  PrincipalAxes(model, &model_centre, &model_axes);
-  if (model_axes.determinant() < 0) model_axes.col(2) *= -1;
-  // The cloud is the visible surface: the hand's middle lies a little farther along the ray.
-  const Eigen::Vector3d centre = data_centre + 8.0 * data_centre.normalized();
-  std::vector<HandPose> hypotheses;
-  for (int s1 : {1, -1}) {
-    for (int s2 : {1, -1}) {
-      Eigen::Matrix3d axes;
-      axes.col(0) = s1 * data_axes.col(0);
-      axes.col(1) = s2 * data_axes.col(1);
-      axes.col(2) = axes.col(0).cross(axes.col(1));
-      const Eigen::Matrix3d rotation = axes * model_axes.transpose();
-      HandPose pose = articulation;
-      pose.cam_from_root = Rigid3(rotation, centre - rotation * model_centre) * pose.cam_from_root;
-      hypotheses.push_back(std::move(pose));
-    }
-  }
-  if (also_unturned) {
-    // Only moved onto the cloud: a hand that moved fast but did not turn much.
-    HandPose moved = articulation;
-    moved.cam_from_root =
-        Rigid3(Eigen::Matrix3d::Identity(), centre - model_centre) * moved.cam_from_root;
-    hypotheses.push_back(std::move(moved));
-  }
-  return hypotheses;
-}
-
 HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_points,
-                                  const Frame& frame) const {
-  std::vector<HandPose> hypotheses =
-      CloudHypotheses(hand_points, HandPose::Rest(model_), /*also_unturned=*/false);
-  if (has_confident_pose_) {
-    for (HandPose& pose : CloudHypotheses(hand_points, confident_pose_, /*also_unturned=*/true))
-      hypotheses.push_back(std::move(pose));
-  }
-  // The articulation the tracker holds now, if it is another (one given to Initialise: a
-  // grasping hand is far from the rest pose's open one, and from the rest articulation alone a
-  // search after a jump mid-grasp settled 122 mm off with 88 % of the points explained).
-  if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad)) {
-    for (HandPose& pose : CloudHypotheses(hand_points, pose_, /*also_unturned=*/true))
-      hypotheses.push_back(std::move(pose));
-  }
-  HandFitResult best = initial_fitter_->Fit(hand_points, &frame, hypotheses.front());
-  for (size_t k = 1; k < hypotheses.size(); ++k) {
-    HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, hypotheses[k]);
-    if (FitScore(fit) < FitScore(best)) best = std::move(fit);
+                                  const Frame& frame, const Segmentation* segmentation) const {
+  // Articulations to place: the open hand and four curls toward a fist, the last confident
+  // pose's and the one held now (a grasping hand is far from the open one: from the open hand
+  // alone a search after a jump mid-grasp settled 122 mm off with 88 % of the points
+  // explained).
+  std::vector<HandPose> articulations;
+  for (double curl : {0.0, 0.2, 0.4, 0.6, 0.8}) articulations.push_back(CurledHand(model_, curl));
+  if (has_confident_pose_) articulations.push_back(confident_pose_);
+  if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad))
+    articulations.push_back(pose_);
+  // The best placed hypotheses fitted briefly; the best few of those fitted on.
+  std::vector<HandFitResult> coarse;
+  for (const SearchHypothesis& hypothesis :
+       search_->Best(hand_points, frame, articulations, options_.search_candidates))
+    coarse.push_back(coarse_fitter_->Fit(hand_points, &frame, hypothesis.pose, segmentation));
+  const size_t kept = std::min<size_t>(coarse.size(), options_.search_refined);
+  std::partial_sort(
+      coarse.begin(), coarse.begin() + kept, coarse.end(),
+      [](const HandFitResult& a, const HandFitResult& b) { return FitScore(a) < FitScore(b); });
+  HandFitResult best;
+  for (size_t k = 0; k < kept; ++k) {
+    HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, coarse[k].pose, segmentation);
+    if (k == 0 || FitScore(fit) < FitScore(best)) best = std::move(fit);
   }
   return best;
 }
@@ -273,7 +239,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   }
 
   if (!has_pose_) {
-    result.fit = Search(points, frame);
+    result.fit = Search(points, frame, &result.segmentation);
     result.status = TrackStatus::kInitialised;
   } else {
     HandPose predicted = pose_;
@@ -290,7 +256,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   if (result.status == TrackStatus::kTracked &&
       doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
     doubtful_in_a_row_ = 0;
-    HandFitResult found = Search(points, frame);
+    HandFitResult found = Search(points, frame, &result.segmentation);
     if (FitScore(found) < FitScore(result.fit)) {
       result.fit = std::move(found);
       result.status = TrackStatus::kInitialised;

@@ -314,6 +314,8 @@ void ScriptedMotionOptions::Check() const {
   IHS_CHECK_ARG(distance_mm >= 300 && distance_mm <= 3000,
                 "scripted.distance_mm must be in [300, 3000]");
   IHS_CHECK_ARG(std::abs(tilt_deg) <= 80, "scripted.tilt_deg must be in [-80, 80]");
+  IHS_CHECK_ARG(std::abs(start_azimuth_deg) <= 180,
+                "scripted.start_azimuth_deg must be in [-180, 180]");
   IHS_CHECK_ARG(sway_mm >= 0 && sway_deg >= 0 && sway_deg <= 45,
                 "scripted.sway_mm must be >= 0 and sway_deg in [0, 45]");
   IHS_CHECK_ARG(press_mm >= 0 && press_mm <= 3, "scripted.press_mm must be in [0, 3]");
@@ -363,7 +365,9 @@ Motion MakeScriptedMotion(const HandModel& hand, const ObjectShape& object,
   // grasps from 62° behind to 28° in front of straight sideways), in the other order.
   const double start_phi =
       right_hand ? -(std::atan2(0.3, 1.0) + step_rad / 2) : std::atan2(0.3, 1.0) - step_rad / 2;
-  const double psi = start_phi - wrist_phi;
+  // A positive start azimuth brings the hand toward the camera, on either hand's side.
+  const double psi = start_phi - wrist_phi +
+                     (right_hand ? -1.0 : 1.0) * options.start_azimuth_deg * M_PI / 180;
   const Eigen::Vector3d b = Eigen::AngleAxisd(psi, axis) * side;
   Eigen::Matrix3d rotation;
   rotation.col(0) = b;

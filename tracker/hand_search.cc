@@ -1,0 +1,285 @@
+#include "tracker/hand_search.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "core/check.h"
+#include "core/point_kd_tree.h"
+#include "core/rigid_fit.h"
+
+namespace ihs::tracker {
+namespace {
+
+// A model point counts as hidden where the depth image sees something this much nearer, mm.
+constexpr double kHiddenMm = 10.0;
+// The share of the nearest pairs each placement iteration keeps, in each direction.
+constexpr double kKeptShare = 0.8;
+
+// Every `stride`-th of `points`, for at most `count` of them.
+template <typename T>
+std::vector<T> Thinned(const std::vector<T>& points, int count) {
+  std::vector<T> out;
+  const size_t stride = std::max<size_t>(1, points.size() / std::max(1, count));
+  for (size_t i = 0; i < points.size(); i += stride) out.push_back(points[i]);
+  return out;
+}
+
+// Rotations spread evenly: `directions` unit vectors on a Fibonacci sphere, each the image of
+// the x axis, turned by `rolls` equal steps about itself.
+std::vector<Eigen::Matrix3d> EvenRotations(int directions, int rolls) {
+  std::vector<Eigen::Matrix3d> rotations;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < directions; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / directions;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Eigen::Vector3d x(r * std::cos(golden * i), r * std::sin(golden * i), z);
+    const Eigen::Vector3d helper =
+        std::abs(x.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+    Eigen::Matrix3d frame;
+    frame.col(0) = x;
+    frame.col(1) = helper.cross(x).normalized();
+    frame.col(2) = x.cross(frame.col(1));
+    for (int k = 0; k < rolls; ++k)
+      rotations.push_back(Eigen::AngleAxisd(2 * M_PI * k / rolls, x).toRotationMatrix() * frame);
+  }
+  return rotations;
+}
+
+// Principal axes (columns, by decreasing spread, right-handed) and centroid of points.
+void PrincipalAxes(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d* centroid,
+                   Eigen::Matrix3d* axes) {
+  *centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) *centroid += p;
+  *centroid /= static_cast<double>(std::max<size_t>(1, points.size()));
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) covariance += (p - *centroid) * (p - *centroid).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  // Eigen sorts ascending; reverse to largest first.
+  for (int k = 0; k < 3; ++k) axes->col(k) = solver.eigenvectors().col(2 - k);
+  if (axes->determinant() < 0) axes->col(2) *= -1;
+}
+
+// One articulation's model points and the hand points, for placing and scoring rigid poses.
+class Placement {
+ public:
+  Placement(const std::vector<Eigen::Vector3f>& model_vertices, const PointKdTree& data_tree,
+            const std::vector<Eigen::Vector3d>& data_sample, const Frame& frame,
+            const CameraIntrinsics& intrinsics, const HandSearchOptions& options)
+      : model_tree_(Thinned(model_vertices, 6 * options.sample_points)),
+        model_sample_(Thinned(model_vertices, 3 * options.sample_points)),
+        data_tree_(data_tree),
+        data_sample_(data_sample),
+        frame_(frame),
+        intrinsics_(intrinsics),
+        options_(options) {}
+
+  // `cam_from_model` moved by `iterations` of rigid ICP onto the hand points; its score in
+  // `score`. Every `stride`-th point is used (a quick look: 3).
+  Rigid3 Place(Rigid3 cam_from_model, int iterations, int stride, double* score) const {
+    for (int iteration = 0; iteration < iterations; ++iteration) {
+      std::vector<Eigen::Vector3d> from, to;
+      Pairs(cam_from_model, stride, &from, &to);
+      if (from.size() < 3) break;
+      cam_from_model = FitRigidTransform(from, to);
+    }
+    *score = Score(cam_from_model, stride);
+    return cam_from_model;
+  }
+
+  // The mean capped distance of the data to the model and of the visible model to the data.
+  double Score(const Rigid3& cam_from_model, int stride) const {
+    const double cap = options_.score_cap_mm;
+    const Rigid3 model_from_cam = cam_from_model.Inverse();
+    double data_sum = 0;
+    int data = 0;
+    for (size_t i = 0; i < data_sample_.size(); i += stride, ++data) {
+      float d2 = 0;
+      model_tree_.Nearest((model_from_cam * data_sample_[i]).cast<float>(), &d2);
+      data_sum += std::min(cap, std::sqrt(static_cast<double>(d2)));
+    }
+    double model_sum = 0;
+    int visible = 0;
+    for (size_t i = 0; i < model_sample_.size(); i += stride) {
+      const Eigen::Vector3d p = cam_from_model * Eigen::Vector3d(model_sample_[i].cast<double>());
+      if (Hidden(p)) continue;
+      float d2 = 0;
+      data_tree_.Nearest(p.cast<float>(), &d2);
+      model_sum += std::min(cap, std::sqrt(static_cast<double>(d2)));
+      ++visible;
+    }
+    if (visible == 0 || data == 0) return std::numeric_limits<double>::infinity();
+    return data_sum / data + model_sum / visible;
+  }
+
+ private:
+  // Whether the depth image sees something nearer than camera-frame point `p`.
+  bool Hidden(const Eigen::Vector3d& p) const {
+    if (p.z() <= 1.0) return true;
+    const Eigen::Vector2d uv = intrinsics_.Project(p);
+    const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+    if (u < 0 || v < 0 || u >= frame_.width || v >= frame_.height) return false;
+    const std::uint16_t depth = frame_.DepthAt(u, v);
+    return depth > 0 && depth < p.z() - kHiddenMm;
+  }
+
+  // Nearest pairs both ways (model point, data point), the nearest share of each kept.
+  void Pairs(const Rigid3& cam_from_model, int stride, std::vector<Eigen::Vector3d>* from,
+             std::vector<Eigen::Vector3d>* to) const {
+    struct Pair {
+      float distance_sq;
+      Eigen::Vector3d model, data;
+    };
+    auto keep_nearest = [&](std::vector<Pair>& pairs) {
+      const size_t kept = static_cast<size_t>(kKeptShare * pairs.size());
+      if (kept == 0) return;
+      std::nth_element(pairs.begin(), pairs.begin() + (kept - 1), pairs.end(),
+                       [](const Pair& a, const Pair& b) { return a.distance_sq < b.distance_sq; });
+      for (size_t k = 0; k < kept; ++k)
+        from->push_back(pairs[k].model), to->push_back(pairs[k].data);
+    };
+    const Rigid3 model_from_cam = cam_from_model.Inverse();
+    std::vector<Pair> pairs;
+    for (size_t k = 0; k < data_sample_.size(); k += stride) {
+      float d2 = 0;
+      const Eigen::Vector3d& p = data_sample_[k];
+      const int i = model_tree_.Nearest((model_from_cam * p).cast<float>(), &d2);
+      pairs.push_back({d2, model_tree_.points()[i].cast<double>(), p});
+    }
+    keep_nearest(pairs);
+    pairs.clear();
+    for (size_t k = 0; k < model_sample_.size(); k += stride) {
+      const Eigen::Vector3d model = model_sample_[k].cast<double>();
+      const Eigen::Vector3d p = cam_from_model * model;
+      if (Hidden(p)) continue;
+      float d2 = 0;
+      const int i = data_tree_.Nearest(p.cast<float>(), &d2);
+      pairs.push_back({d2, model, data_tree_.points()[i].cast<double>()});
+    }
+    keep_nearest(pairs);
+  }
+
+  const PointKdTree model_tree_;
+  const std::vector<Eigen::Vector3f> model_sample_;
+  const PointKdTree& data_tree_;
+  const std::vector<Eigen::Vector3d>& data_sample_;
+  const Frame& frame_;
+  const CameraIntrinsics& intrinsics_;
+  const HandSearchOptions& options_;
+};
+
+}  // namespace
+
+HandPose CurledHand(const HandModel& model, double fraction) {
+  HandPose pose = HandPose::Rest(model);
+  pose.cam_from_root = Rigid3();
+  const std::vector<DegreeOfFreedom> dofs = JointDegreesOfFreedom(model);
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    const double min_deg = model.limits[dofs[k].bone].limits_deg[dofs[k].axis].first;
+    if (dofs[k].axis == 1 && model.bones[dofs[k].bone].parent >= 0 && min_deg < 0)
+      pose.angles_rad[k] = fraction * min_deg * M_PI / 180.0;
+  }
+  return pose;
+}
+
+void HandSearchOptions::Check() const {
+  IHS_CHECK_ARG(directions >= 1 && directions <= 1000,
+                "tracker.search.directions must be in [1, 1000]");
+  IHS_CHECK_ARG(rolls >= 1 && rolls <= 360, "tracker.search.rolls must be in [1, 360]");
+  IHS_CHECK_ARG(placement_iterations >= 0 && placement_iterations <= 100,
+                "tracker.search.placement_iterations must be in [0, 100]");
+  IHS_CHECK_ARG(sample_points >= 10 && sample_points <= 100000,
+                "tracker.search.sample_points must be in [10, 100000]");
+  IHS_CHECK_ARG(score_cap_mm > 0, "tracker.search.score_cap_mm must be positive");
+}
+
+HandSearch::HandSearch(const HandModel& model, const CameraIntrinsics& intrinsics,
+                       HandSearchOptions options)
+    : model_(model),
+      intrinsics_(intrinsics),
+      options_((options.Check(), options)),
+      orientations_(EvenRotations(options_.directions, options_.rolls)) {}
+
+std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f>& hand_points,
+                                               const Frame& frame,
+                                               const std::vector<HandPose>& articulations,
+                                               int count) const {
+  std::vector<SearchHypothesis> found;
+  if (hand_points.empty() || count <= 0) return found;
+  const PointKdTree data_tree(Thinned(hand_points, 6 * options_.sample_points));
+  std::vector<Eigen::Vector3d> data;
+  for (const Eigen::Vector3f& p : Thinned(hand_points, options_.sample_points))
+    data.push_back(p.cast<double>());
+  Eigen::Vector3d data_centre;
+  Eigen::Matrix3d data_axes;
+  PrincipalAxes(data, &data_centre, &data_axes);
+  // The points are the hand's near surface: its middle lies a little farther along the ray.
+  const Eigen::Vector3d centre = data_centre + 8.0 * data_centre.normalized();
+
+  // Every start placed roughly (one ICP iteration) and scored.
+  struct Start {
+    int articulation;
+    Rigid3 cam_from_model;
+    double score;
+  };
+  std::vector<Start> starts;
+  std::vector<std::unique_ptr<Placement>> placements;
+  std::vector<HandPose> poses;
+  for (HandPose articulation : articulations) {
+    const Rigid3 given = articulation.cam_from_root;
+    articulation.cam_from_root = Rigid3();
+    const std::vector<Eigen::Vector3f> vertices =
+        model_.Pose(ForwardKinematics(model_, articulation)).vertices;
+    std::vector<Eigen::Vector3d> model_points;
+    for (const Eigen::Vector3f& v : Thinned(vertices, 3 * options_.sample_points))
+      model_points.push_back(v.cast<double>());
+    Eigen::Vector3d model_centre;
+    Eigen::Matrix3d model_axes;
+    PrincipalAxes(model_points, &model_centre, &model_axes);
+    // The even rotations, and the model's principal axes onto the cloud's, eight ways round.
+    std::vector<Eigen::Matrix3d> rotations = orientations_;
+    for (int sign : {1, -1}) {
+      for (int quarter = 0; quarter < 4; ++quarter) {
+        Eigen::Matrix3d axes;
+        axes.col(0) = sign * data_axes.col(0);
+        axes.col(1) = data_axes.col(1);
+        axes.col(2) = axes.col(0).cross(axes.col(1));
+        axes = Eigen::AngleAxisd(quarter * M_PI / 2, axes.col(0)).toRotationMatrix() * axes;
+        rotations.push_back(axes * model_axes.transpose());
+      }
+    }
+    const int index = static_cast<int>(poses.size());
+    placements.push_back(
+        std::make_unique<Placement>(vertices, data_tree, data, frame, intrinsics_, options_));
+    poses.push_back(articulation);
+    auto add = [&](const Rigid3& start) {
+      double score = 0;
+      const Rigid3 placed = placements.back()->Place(start, 1, 3, &score);
+      starts.push_back({index, placed, score});
+    };
+    for (const Eigen::Matrix3d& rotation : rotations)
+      add(Rigid3(rotation, centre - rotation * model_centre));
+    // A pose given with the articulation (a tracked one) is also placed from where it is.
+    if (!given.rotation().isIdentity() || !given.translation().isZero()) add(given);
+  }
+  // The best of them placed fully.
+  auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };
+  const size_t placed = std::min<size_t>(starts.size(), 4 * static_cast<size_t>(count));
+  std::partial_sort(starts.begin(), starts.begin() + placed, starts.end(), by_score);
+  for (size_t k = 0; k < placed; ++k) {
+    SearchHypothesis hypothesis;
+    hypothesis.pose = poses[starts[k].articulation];
+    hypothesis.pose.cam_from_root = placements[starts[k].articulation]->Place(
+        starts[k].cam_from_model, options_.placement_iterations, 1, &hypothesis.score);
+    found.push_back(std::move(hypothesis));
+  }
+  const size_t kept = std::min<size_t>(found.size(), count);
+  std::partial_sort(found.begin(), found.begin() + kept, found.end(), by_score);
+  found.resize(kept);
+  return found;
+}
+
+}  // namespace ihs::tracker

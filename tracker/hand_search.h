@@ -1,0 +1,69 @@
+#pragma once
+// Where a hand might be, from nothing but its points: the hand-tracker's global search. Many
+// whole-hand orientations (spread evenly over all rotations, and the hand cloud's principal
+// axes each way round) of a few articulations are each moved rigidly onto the hand points and
+// ranked by how well the depth image agrees with them; the best few go on to the articulated
+// fit (HandTracker). The articulated fit only finds the pose near where it starts: started
+// from the cloud's principal axes alone, grasping hands on the generator's scripted motions
+// were 20–76° from every hypothesis and were fitted 35–100 mm off.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "tracker/hand_model.h"
+#include "tracker/hand_pose.h"
+
+namespace ihs::tracker {
+
+/// Options of the search (defaults: about 30° between neighbouring orientations).
+struct HandSearchOptions {
+  /// Directions of the hand's long axis (spread evenly over the sphere) and turns about it per
+  /// direction: directions × rolls orientations per articulation, besides the principal axes'.
+  int directions = 26;
+  int rolls = 8;
+  /// Rigid ICP iterations placing each orientation on the hand points.
+  int placement_iterations = 6;
+  /// Model and data points used to place and score a hypothesis, at most.
+  int sample_points = 250;
+  /// A model point's distance to the nearest hand point counts up to this, mm (and the other
+  /// way round): a hypothesis is scored by the mean of both.
+  double score_cap_mm = 30.0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// A hypothesis and its score (mean capped distance, mm; lower is better).
+struct SearchHypothesis {
+  HandPose pose;
+  double score = 0;
+};
+
+/// The global search for one model and camera.
+class HandSearch {
+ public:
+  HandSearch(const HandModel& model, const CameraIntrinsics& intrinsics,
+             HandSearchOptions options = {});
+
+  /// The `count` best placed hypotheses (best first) for `hand_points` (camera frame, mm) seen
+  /// in `frame`, over every articulation in `articulations` (their root poses are ignored).
+  std::vector<SearchHypothesis> Best(const std::vector<Eigen::Vector3f>& hand_points,
+                                     const Frame& frame, const std::vector<HandPose>& articulations,
+                                     int count) const;
+
+  const HandSearchOptions& options() const { return options_; }
+
+ private:
+  const HandModel& model_;
+  const CameraIntrinsics intrinsics_;
+  const HandSearchOptions options_;
+  std::vector<Eigen::Matrix3d> orientations_;
+};
+
+/// The joint angles of `model` with every finger flexed by `fraction` of its flexion limit
+/// toward the palm (root pose: identity).
+HandPose CurledHand(const HandModel& model, double fraction);
+
+}  // namespace ihs::tracker
