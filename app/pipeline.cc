@@ -402,6 +402,7 @@ void Pipeline::ExportLoop() {
                               {"frames_per_second", progress.FramesPerSecond()},
                               {"peak_rss_mib", PeakResidentMiB()},
                               {"hand_scale", s.hand->scale()},
+                              {"hand_scale_at_bound", s.hand->scale_at_bound()},
                               {"export_ms",
                                {{"total", exported.milliseconds},
                                 {"cleanup", exported.meshes.cleanup_ms},

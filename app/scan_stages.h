@@ -80,6 +80,8 @@ class HandStage {
   const tracker::HandModel& model() const { return tracker_.model(); }
   /// The template's scale relative to the one loaded (estimated or given).
   double scale() const;
+  /// Whether an estimated scale lies on a bound of its range (tracker::HandTracker).
+  bool scale_at_bound() const { return tracker_.scale_at_bound(); }
   /// Names of the template's bones (the joints' columns).
   std::vector<std::string> BoneNames() const;
 

@@ -132,6 +132,7 @@ int Run(const Args& args) {
   nlohmann::json summary = record.Summary();
   nlohmann::json extra = {
       {"hand_scale", hand.scale()},
+      {"hand_scale_at_bound", hand.scale_at_bound()},
       {"gamma_t", args.gamma_t},
       {"icp", !args.no_icp},
       {"visual", !args.contacts_only},

@@ -148,6 +148,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   nlohmann::json summary = {{"frames", index},
                             {"hand_scale", tracker.scale() * (hand_scale > 0 ? hand_scale : 1.0)},
                             {"hand_scale_estimated", options.scale_frames > 0},
+                            {"hand_scale_at_bound", tracker.scale_at_bound()},
                             {"status_counts", counts},
                             {"ms_mean", total_ms / index},
                             {"ms_p95", Quantile(milliseconds, 0.95)},
@@ -170,7 +171,9 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
               static_cast<long long>(index), counts["tracked"], counts["initialised"],
               counts["diverged"], counts["no_hand"], counts["empty_frame"]);
   std::printf("hand scale: %.3f (%s)\n", summary["hand_scale"].get<double>(),
-              options.scale_frames > 0 ? "estimated over the first frames" : "given");
+              options.scale_frames == 0    ? "given"
+              : tracker.scale_at_bound() ? "estimated over the first frames, on a bound of its range"
+                                         : "estimated over the first frames");
   std::printf(
       "time per frame: %.1f ms mean, %.1f ms p95 (one core); segmentation %.1f, fit %.1f, "
       "contacts %.1f ms\n",

@@ -150,6 +150,13 @@ void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& f
     if (scale_candidates_[k]->score < scale_candidates_[best]->score) best = k;
   }
   double scale = scale_candidates_[best]->scale;
+  scale_at_bound_ = best == 0 || best + 1 == scale_candidates_.size();
+  if (scale_at_bound_) {
+    // Searching anew and estimating again did not help (docs/tracker.md): said, not retried.
+    spdlog::warn("hand scale estimate {:.2f} is on a bound of its range: the hand may be that "
+                 "size or beyond, or its first fits were wrong (scan.hand_scale sets it)",
+                 scale);
+  }
   if (best > 0 && best + 1 < scale_candidates_.size()) {
     // The minimum of the parabola through the best score and its neighbours.
     const double a = scale_candidates_[best - 1]->score, b = scale_candidates_[best]->score,

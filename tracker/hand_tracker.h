@@ -134,6 +134,9 @@ class HandTracker {
   double scale() const { return scale_; }
   /// Whether the template's scale is still being estimated.
   bool estimating_scale() const { return !scale_candidates_.empty(); }
+  /// Whether the estimate lies on a bound of its range (the hand may be that size or beyond, or
+  /// its first fits were wrong).
+  bool scale_at_bound() const { return scale_at_bound_; }
   const TrackerOptions& options() const { return options_; }
 
  private:
@@ -162,6 +165,7 @@ class HandTracker {
   std::unique_ptr<ContactDetector> contacts_;
   std::vector<std::unique_ptr<ScaleCandidate>> scale_candidates_;
   int scale_frames_done_ = 0;
+  bool scale_at_bound_ = false;
   bool has_pose_ = false;
   HandPose pose_;
   HandPose previous_pose_;

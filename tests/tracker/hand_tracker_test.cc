@@ -101,8 +101,9 @@ TEST(HandTrackerTest, TracksFromTheTruthAndFindsTheTouchingFingertips) {
 TEST(HandTrackerTest, EstimatesTheHandsScaleOverTheFirstFrames) {
   if (test::HandDataDir().empty()) GTEST_SKIP() << "../shared/data is absent";
   synth::SequenceRenderer renderer(RecordedSphere(45));  // Only the first 12 frames are used.
-  // The real hand is rendered; the tracker gets its template 8 % too small and too large.
-  for (double template_scale : {0.92, 1.08}) {
+  // The real hand is rendered; the tracker gets its template 8 % too small and too large, and
+  // 30 % too large: beyond the estimate's range, which says so.
+  for (double template_scale : {0.92, 1.08, 1.3}) {
     const HandModel model = renderer.hand().Scaled(template_scale);
     HandTracker tracker(model, renderer.options().intrinsics);
     ASSERT_TRUE(tracker.estimating_scale());
@@ -114,7 +115,13 @@ TEST(HandTrackerTest, EstimatesTheHandsScaleOverTheFirstFrames) {
     const double hand = template_scale * tracker.scale();
     std::printf("template %.2f: scale %.3f, the hand %.3f of its true size\n", template_scale,
                 tracker.scale(), hand);
-    // Measured: 0.954 and 0.973. The estimate comes out a few per cent small: the sensor loses
+    if (template_scale > 1.2) {
+      EXPECT_TRUE(tracker.scale_at_bound());
+      EXPECT_NEAR(tracker.scale(), 1.0 - tracker.options().scale_range, 1e-9);
+      continue;
+    }
+    EXPECT_FALSE(tracker.scale_at_bound());
+    // Measured: 0.953 and 1.009. The estimate comes out a few per cent small: the sensor loses
     // depth at the silhouette's edge, so the hand looks thinner than it is.
     EXPECT_NEAR(hand, 1.0, 0.06);
     // The frame after the switch to the estimated scale: measured 4.21 and 6.16 mm (with four
