@@ -258,8 +258,7 @@ void Pipeline::TrackerLoop() {
       s.hand->Process(*packet);
       {
         std::lock_guard<std::mutex> lock(s.mutex);
-        s.tracking = packet->frame_error.empty() ? tracker::ToString(packet->track.status)
-                                                 : "malformed frame";
+        s.tracking = packet->frame_error.empty() ? packet->track.State() : "malformed frame";
       }
       if (!s.tracked.Push(std::move(packet))) break;  // The fusion thread has stopped.
     }
@@ -340,7 +339,7 @@ void Pipeline::FusionLoop() {
           view.contacts_mm.push_back(pair.current_mm);
         view.model =
             ViewModel(object->volume(), s.intrinsics, packet->fusion.cam_from_object).image;
-        view.tracking = tracker::ToString(packet->track.status);
+        view.tracking = packet->track.State();
         live_view_.Put(std::move(view));
       }
     }

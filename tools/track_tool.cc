@@ -79,6 +79,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   std::string contacts_csv = "frame,status,contact_bones,contact_vertices,threshold_mm\n";
   nlohmann::json frames = nlohmann::json::array();
   std::map<std::string, int> counts;
+  int doubtful = 0;  // Frames whose pose was doubtful.
   std::vector<double> joint_errors, contact_errors, milliseconds;
   double stage_ms[3] = {0, 0, 0};
   std::int64_t index = 0;
@@ -103,6 +104,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
     stage_ms[0] += result.segmentation_ms, stage_ms[1] += result.fit_ms,
         stage_ms[2] += result.contacts_ms;
     if (!result.reason.empty()) entry["reason"] = result.reason;
+    if (result.doubtful) entry["doubtful"] = true, ++doubtful;
     if (!result.joints_mm.empty()) {
       entry["data_coverage"] = result.fit.data_coverage;
       entry["model_coverage"] = result.fit.model_coverage;
@@ -150,6 +152,7 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
                             {"hand_scale_estimated", options.scale_frames > 0},
                             {"hand_scale_at_bound", tracker.scale_at_bound()},
                             {"status_counts", counts},
+                            {"doubtful_frames", doubtful},
                             {"ms_mean", total_ms / index},
                             {"ms_p95", Quantile(milliseconds, 0.95)},
                             {"segmentation_ms_mean", stage_ms[0] / index},
@@ -167,9 +170,10 @@ int Run(const std::string& input, const fs::path& out, const std::string& gt_dir
   }
   ihs::WriteFileAtomically(out / "stats.json",
                            nlohmann::json{{"summary", summary}, {"frames", frames}}.dump(1) + "\n");
-  std::printf("frames %lld: tracked %d, initialised %d, diverged %d, no hand %d, empty %d\n",
-              static_cast<long long>(index), counts["tracked"], counts["initialised"],
-              counts["diverged"], counts["no_hand"], counts["empty_frame"]);
+  std::printf(
+      "frames %lld: tracked %d, initialised %d, diverged %d, no hand %d, empty %d; doubtful %d\n",
+      static_cast<long long>(index), counts["tracked"], counts["initialised"], counts["diverged"],
+      counts["no_hand"], counts["empty_frame"], doubtful);
   std::printf("hand scale: %.3f (%s)\n", summary["hand_scale"].get<double>(),
               options.scale_frames == 0    ? "given"
               : tracker.scale_at_bound() ? "estimated over the first frames, on a bound of its range"

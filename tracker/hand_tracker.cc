@@ -273,8 +273,10 @@ TrackResult HandTracker::Track(const Frame& frame) {
     confident_pose_ = result.fit.pose;
     has_confident_pose_ = true;
   }
+  result.doubtful = result.fit.data_coverage < options_.search_data_coverage;
   if (result.fit.data_coverage < options_.min_data_coverage) {
     result.status = TrackStatus::kDiverged;
+    result.doubtful = false;  // Not doubtful: diverged.
     result.reason = "fit explains " +
                     std::to_string(static_cast<int>(100 * result.fit.data_coverage)) +
                     " % of the hand points";

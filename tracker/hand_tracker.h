@@ -101,6 +101,10 @@ struct TrackResult {
   std::vector<ContactPair> contact_pairs;
   Segmentation segmentation;
   HandFitResult fit;
+  /// The pose is given, but its fit explains fewer than TrackerOptions::search_data_coverage of
+  /// the hand points: the hand may be in the wrong place or turned the wrong way round (the
+  /// tracker searches anew after doubtful_frames_to_search such frames in a row).
+  bool doubtful = false;
   /// The template's scale in use (1 until an estimate is made; see TrackerOptions).
   double hand_scale = 1.0;
   /// Time spent on this frame, ms: in all, and on segmentation, the pose fit (with any
@@ -113,6 +117,10 @@ struct TrackResult {
   /// Whether the pose is usable (tracked or initialised).
   bool HasPose() const {
     return status == TrackStatus::kTracked || status == TrackStatus::kInitialised;
+  }
+  /// The status for a person: ToString(status), with " (doubtful)" after a doubtful pose.
+  std::string State() const {
+    return std::string(ToString(status)) + (doubtful ? " (doubtful)" : "");
   }
 };
 

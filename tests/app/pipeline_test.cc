@@ -240,6 +240,10 @@ TEST_F(PipelineFaultTest, MalformedAndEmptyFramesAreSkippedWithTheirReasons) {
   EXPECT_EQ(stats["summary"]["skip_reasons"]["malformed frame"], 2);
   EXPECT_EQ(stats["frames"][5]["fusion"], "skipped");
   EXPECT_EQ(stats["frames"][9]["fusion"], "skipped");
+  // The summary counts the frames whose hand pose was doubtful, as the frames say.
+  int doubtful = 0;
+  for (const auto& frame : stats["frames"]) doubtful += frame.value("track_doubtful", false);
+  EXPECT_EQ(stats["summary"]["hand_doubtful_frames"], doubtful);
   EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
 }
 
