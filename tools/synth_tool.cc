@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--start-azimuth-deg", options.scripted.start_azimuth_deg,
                  "where the hand starts about the object's axis, from the default side "
-                 "position (scripted motion; about 90: the hand in front, its back to the camera)")
+                 "position (scripted motion; the sphere at 90: the hand in front, its back to the camera)")
       ->capture_default_str();
   app.add_flag("--no-oni", no_oni, "do not write sequence.oni");
   app.add_flag("--no-tum", no_tum, "do not write the tum/ folder");

@@ -40,11 +40,12 @@ TEST(HandSearchTest, ACurledHandsFingertipsComeTowardThePalm) {
 }
 
 TEST(HandSearchTest, FindsTheTruePoseAmongManyOrientationsFromTheHandPointsAlone) {
-  // The scripted grasp of a box, the hand beside it (the default start) and behind it (palm
-  // and fingertips toward the camera). Not yet found: the hand in front of the box, its back
-  // toward the camera (start azimuth 90°): the truth placed from itself scores 11.8, better
-  // than the 14.8 of the best hypothesis found (117° off), but no orientation tried reaches
-  // the truth's basin (issue 32).
+  // The scripted grasp of a box (seed 17), the hand beside it (the default start) and 60°
+  // earlier round it, in front of the box with its back to the camera. Not yet found: 90°
+  // farther round, behind the box, where only the thumb and part of the back of the hand show
+  // and the fingertips at the box's edge are not among the hand points: the truth placed from
+  // itself scores 11.8, better than the 14.8 of the best hypothesis found (117° off), but no
+  // start reaches the truth's basin (issue 32).
   for (double azimuth : {0.0, -60.0}) {
     synth::SequenceOptions options;
     options.object = "box";

@@ -365,7 +365,7 @@ Motion MakeScriptedMotion(const HandModel& hand, const ObjectShape& object,
   // grasps from 62° behind to 28° in front of straight sideways), in the other order.
   const double start_phi =
       right_hand ? -(std::atan2(0.3, 1.0) + step_rad / 2) : std::atan2(0.3, 1.0) - step_rad / 2;
-  // A positive start azimuth brings the hand toward the camera, on either hand's side.
+  // The start azimuth turns the same way round for either hand (a mirror image).
   const double psi = start_phi - wrist_phi +
                      (right_hand ? -1.0 : 1.0) * options.start_azimuth_deg * M_PI / 180;
   const Eigen::Vector3d b = Eigen::AngleAxisd(psi, axis) * side;

@@ -27,9 +27,9 @@ struct ScriptedMotionOptions {
   /// The object's axis leans this much from the image's vertical toward the camera, degrees.
   double tilt_deg = 20.0;
   /// Where the hand starts about the object's axis, degrees from the default start (the wrist
-  /// on the hand's own side of the object, half a grasp before straight sideways). Positive
-  /// brings the hand toward the camera: at about +90 the back of the hand and the fingers
-  /// hide most of the object; at about -90 the hand is behind it.
+  /// on the hand's own side of the object, half a grasp before straight sideways), the same
+  /// way round for either hand. With the sphere, +90 puts the hand in front of it (its back to
+  /// the camera) and -90 behind; with other objects the grasp solved for them decides.
   double start_azimuth_deg = 0.0;
   /// Per grasp, the object also moves by up to this much (seeded), so the motion is not a pure
   /// rotation about a fixed axis: translation per axis, mm, and tilt, degrees.
