@@ -17,7 +17,7 @@
 
 namespace ihs::tracker {
 
-/// Options of the search (defaults: about 30° between neighbouring orientations).
+/// Options of the search (defaults: neighbouring orientations about 40–45° apart).
 struct HandSearchOptions {
   /// Directions of the hand's long axis (spread evenly over the sphere) and turns about it per
   /// direction: directions × rolls orientations per articulation, besides the principal axes'.
