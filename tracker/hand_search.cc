@@ -206,6 +206,7 @@ HandSearch::HandSearch(const HandModel& model, const CameraIntrinsics& intrinsic
 std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f>& hand_points,
                                                const Frame& frame,
                                                const std::vector<HandPose>& articulations,
+                                               const std::vector<HandPose>& tracked,
                                                int count) const {
   std::vector<SearchHypothesis> found;
   if (hand_points.empty() || count <= 0) return found;
@@ -228,8 +229,11 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
   std::vector<Start> starts;
   std::vector<std::unique_ptr<Placement>> placements;
   std::vector<HandPose> poses;
-  for (HandPose articulation : articulations) {
-    const Rigid3 given = articulation.cam_from_root;
+  std::vector<std::pair<HandPose, bool>> sources;  // An articulation; whether it was tracked.
+  for (const HandPose& pose : articulations) sources.emplace_back(pose, false);
+  for (const HandPose& pose : tracked) sources.emplace_back(pose, true);
+  for (auto& [articulation, was_tracked] : sources) {
+    const Rigid3 held = articulation.cam_from_root;
     articulation.cam_from_root = Rigid3();
     const std::vector<Eigen::Vector3f> vertices =
         model_.Pose(ForwardKinematics(model_, articulation)).vertices;
@@ -262,8 +266,8 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     };
     for (const Eigen::Matrix3d& rotation : rotations)
       add(Rigid3(rotation, centre - rotation * model_centre));
-    // A pose given with the articulation (a tracked one) is also placed from where it is.
-    if (!given.rotation().isIdentity() || !given.translation().isZero()) add(given);
+    // A tracked pose is also placed from where it was.
+    if (was_tracked) add(held);
   }
   // The best of them placed fully.
   auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };

@@ -48,10 +48,12 @@ class HandSearch {
              HandSearchOptions options = {});
 
   /// The `count` best placed hypotheses (best first) for `hand_points` (camera frame, mm) seen
-  /// in `frame`, over every articulation in `articulations` (their root poses are ignored).
+  /// in `frame`, over every articulation in `articulations` and `tracked` in every orientation
+  /// (their root poses ignored); each of `tracked` (poses the tracker held) is also placed from
+  /// its own root pose.
   std::vector<SearchHypothesis> Best(const std::vector<Eigen::Vector3f>& hand_points,
                                      const Frame& frame, const std::vector<HandPose>& articulations,
-                                     int count) const;
+                                     const std::vector<HandPose>& tracked, int count) const;
 
   const HandSearchOptions& options() const { return options_; }
 

@@ -193,16 +193,16 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
   // Articulations to place: the open hand and four curls toward a fist, the last confident
   // pose's and the one held now (a grasping hand is far from the open one: from the open hand
   // alone a search after a jump mid-grasp settled 122 mm off with 88 % of the points
-  // explained).
-  std::vector<HandPose> articulations;
+  // explained); those two also from where they were.
+  std::vector<HandPose> articulations, tracked;
   for (double curl : {0.0, 0.2, 0.4, 0.6, 0.8}) articulations.push_back(CurledHand(model_, curl));
-  if (has_confident_pose_) articulations.push_back(confident_pose_);
+  if (has_confident_pose_) tracked.push_back(confident_pose_);
   if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad))
-    articulations.push_back(pose_);
+    tracked.push_back(pose_);
   // The best placed hypotheses fitted briefly; the best few of those fitted on.
   std::vector<HandFitResult> coarse;
   for (const SearchHypothesis& hypothesis :
-       search_->Best(hand_points, frame, articulations, options_.search_candidates))
+       search_->Best(hand_points, frame, articulations, tracked, options_.search_candidates))
     coarse.push_back(coarse_fitter_->Fit(hand_points, &frame, hypothesis.pose, segmentation));
   const size_t kept = std::min<size_t>(coarse.size(), options_.search_refined);
   std::partial_sort(

@@ -24,7 +24,7 @@ struct SegmentationOptions {
   /// tracker that sees only the fingertips loses the hand. And z starts at 250: the paper's
   /// Carmine 1.09 measures from about 350 mm, and a hand holding the object 360–430 mm away
   /// lost its near half to the paper's 400 (the tracker then fitted it 68–101 mm off; from 250,
-  /// 13–24 mm; docs/tracker.md).
+  /// 13–24 mm on four of five such draws; docs/tracker.md).
   Eigen::Vector3d crop_min_mm{-100, -220, 250};
   Eigen::Vector3d crop_max_mm{100, 220, 1000};
   /// A pixel is skin when log p(rgb | skin) − log p(rgb | non-skin) exceeds this.
