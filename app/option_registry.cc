@@ -1,11 +1,13 @@
 #include "app/option_registry.h"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 
 namespace ihs::app {
@@ -25,13 +27,21 @@ std::string FormatDouble(double value) {
   return std::string(buffer, result.ptr);
 }
 
+// A number of the field's type; for floating point a finite one (no option means anything by
+// nan or inf, and they pass every range check written as a comparison).
 template <typename T>
 bool ParseNumber(const std::string& text, T* value) {
   const std::string trimmed = Trim(text);
   if (trimmed.empty()) return false;
   const char* end = trimmed.data() + trimmed.size();
-  const auto result = std::from_chars(trimmed.data(), end, *value);
-  return result.ec == std::errc() && result.ptr == end;
+  T parsed{};
+  const auto result = std::from_chars(trimmed.data(), end, parsed);
+  if (result.ec != std::errc() || result.ptr != end) return false;
+  if constexpr (std::is_floating_point_v<T>) {
+    if (!std::isfinite(parsed)) return false;
+  }
+  *value = parsed;
+  return true;
 }
 
 }  // namespace
@@ -132,8 +142,11 @@ void OptionRegistry::SetAssignment(const std::string& assignment) {
 }
 
 void OptionRegistry::Load(const std::filesystem::path& path) {
-  std::ifstream file(path);
-  if (!file) throw InputError(path.string() + ": cannot read the config file");
+  LoadText(ReadFileToString(path, kMaxConfigBytes), path.string());
+}
+
+void OptionRegistry::LoadText(const std::string& text, const std::string& source) {
+  std::istringstream file(text);
   std::string section;
   int line_number = 0;
   for (std::string line; std::getline(file, line);) {
@@ -142,7 +155,7 @@ void OptionRegistry::Load(const std::filesystem::path& path) {
     if (hash != std::string::npos) line.erase(hash);
     line = Trim(line);
     if (line.empty()) continue;
-    const std::string where = path.string() + ":" + std::to_string(line_number) + ": ";
+    const std::string where = source + ":" + std::to_string(line_number) + ": ";
     if (line.front() == '[') {
       if (line.back() != ']') throw std::invalid_argument(where + "unclosed section header");
       section = Trim(line.substr(1, line.size() - 2));

@@ -25,15 +25,20 @@ class OptionRegistry {
   void Add(const std::string& name, Eigen::Vector3d* field, const std::string& help);
 
   /// Sets the field `name` from text. Throws std::invalid_argument naming the option when the
-  /// name is unknown or the value does not parse as the field's type.
+  /// name is unknown or the value does not parse as the field's type (floating point: a finite
+  /// number; nan and inf are refused). Ranges are the options structs' Check().
   void Set(const std::string& name, const std::string& value);
   /// Sets from "NAME=VALUE".
   void SetAssignment(const std::string& assignment);
 
   /// Reads a config file: `name = value` lines, `#` comments, blank lines, and `[section]`
   /// headers that prefix the names below them with "section.". Throws ihs::InputError when the
-  /// file cannot be read, std::invalid_argument (with file and line) for a bad line.
+  /// file cannot be read, is not a regular file (a folder, a FIFO, /dev/zero) or is larger than
+  /// `kMaxConfigBytes`; std::invalid_argument (with file and line) for a bad line.
+  static constexpr std::uintmax_t kMaxConfigBytes = 1 << 20;
   void Load(const std::filesystem::path& path);
+  /// The same for the text of a config file; `source` names it in error messages.
+  void LoadText(const std::string& text, const std::string& source);
 
   /// Every option with its current value and help, as a config file that Load reads back.
   std::string Describe() const;

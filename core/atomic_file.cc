@@ -58,16 +58,31 @@ void WriteFileAtomically(const fs::path& path, const std::string& contents) {
                       [&](std::ostream& out) { out.write(contents.data(), contents.size()); });
 }
 
-std::string ReadFileToString(const fs::path& path) {
+std::string ReadFileToString(const fs::path& path, std::uintmax_t max_bytes) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw InputError(path.string() + ": no such file");
   if (!fs::is_regular_file(path, ec)) throw InputError(path.string() + ": not a regular file");
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (!ec && size > max_bytes) {
+    throw InputError(path.string() + ": " + std::to_string(size) + " bytes, more than the " +
+                     std::to_string(max_bytes) + " such a file may have");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open: " + std::strerror(errno));
-  std::ostringstream contents;
-  contents << in.rdbuf();
+  // Read in pieces up to one byte past the bound: a file that grew since does not grow the
+  // memory past it.
+  std::string contents;
+  char piece[1 << 16];
+  while (in && contents.size() <= max_bytes) {
+    in.read(piece, sizeof piece);
+    contents.append(piece, static_cast<std::size_t>(in.gcount()));
+  }
   if (in.bad()) throw InputError(path.string() + ": read error");
-  return std::move(contents).str();
+  if (contents.size() > max_bytes) {
+    throw InputError(path.string() + ": more than the " + std::to_string(max_bytes) +
+                     " bytes such a file may have");
+  }
+  return contents;
 }
 
 }  // namespace ihs

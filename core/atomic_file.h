@@ -1,6 +1,7 @@
 #pragma once
 // Atomic file writing: readers see either the old file or the complete new one, never a part.
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <ostream>
@@ -20,7 +21,10 @@ void WriteFileAtomically(const std::filesystem::path& path,
 void WriteFileAtomically(const std::filesystem::path& path, const std::string& contents);
 
 /// Reads a whole file into a string. Throws ihs::InputError naming the path when it is missing,
-/// not a regular file, or unreadable.
-std::string ReadFileToString(const std::filesystem::path& path);
+/// not a regular file (a folder, a FIFO, a device such as /dev/zero: never read, so never a
+/// hang), larger than `max_bytes`, or unreadable.
+inline constexpr std::uintmax_t kDefaultMaxReadBytes = 256ull << 20;
+std::string ReadFileToString(const std::filesystem::path& path,
+                             std::uintmax_t max_bytes = kDefaultMaxReadBytes);
 
 }  // namespace ihs

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <stdexcept>
 
 #include "core/errors.h"
@@ -15,9 +16,11 @@ std::string ExitCodesHelp() {
 
 std::string OneLine(const std::string& message) {
   // Runs of whitespace with a line break become "; ", other runs one space; none at the ends.
+  // Other control bytes (a file header's escape sequences) become '?'.
   std::string line;
   bool pending_space = false, pending_break = false;
   for (const char ch : message) {
+    const auto byte = static_cast<unsigned char>(ch);
     if (ch == '\n' || ch == '\r') {
       pending_break = true;
     } else if (ch == ' ' || ch == '\t') {
@@ -29,8 +32,14 @@ std::string OneLine(const std::string& message) {
         line += ' ';
       }
       pending_space = pending_break = false;
-      line += ch;
+      line += (byte < 0x20 || byte == 0x7f) ? '?' : ch;
     }
+  }
+  if (line.size() > kMaxLineBytes) {
+    // Cut at a character boundary (not inside a UTF-8 sequence).
+    std::size_t cut = kMaxLineBytes;
+    while (cut > 0 && (static_cast<unsigned char>(line[cut]) & 0xC0) == 0x80) --cut;
+    line = line.substr(0, cut) + " [" + std::to_string(line.size() - cut) + " more bytes]";
   }
   return line;
 }
@@ -50,6 +59,10 @@ int RunReportingErrors(const std::string& program, const std::function<int()>& b
     return report(error.what(), kExitDevice);
   } catch (const OutputError& error) {
     return report(error.what(), kExitOutput);
+  } catch (const std::filesystem::filesystem_error& error) {
+    // A path the program was given that the file system cannot resolve (a symlink loop, a
+    // name too long, no permission), met before a reader could say so in its own words.
+    return report(error.what(), kExitInput);
   } catch (const std::exception& error) {
     return report(error.what(), kExitInternal);
   } catch (...) {

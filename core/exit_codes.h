@@ -2,6 +2,7 @@
 // Exit codes shared by every executable of the project, and the one place that turns an
 // exception into a one-line error message and such a code.
 
+#include <cstddef>
 #include <functional>
 #include <string>
 
@@ -22,13 +23,17 @@ enum ExitCode : int {
 std::string ExitCodesHelp();
 
 /// `message` on one line: runs of whitespace that hold a line break become "; ", other runs a
-/// single space.
+/// single space, other control bytes '?'; longer than `kMaxLineBytes`, it is cut there (at a
+/// character boundary) and says how much was left out. Text from files and command lines can
+/// be echoed through it safely.
+inline constexpr std::size_t kMaxLineBytes = 400;
 std::string OneLine(const std::string& message);
 
 /// Runs `body` and returns its exit code; an exception escaping it is printed to stderr as one
 /// line "<program>: error: <message>" (see OneLine) and mapped to its exit code
-/// (std::invalid_argument → kExitUsage, InputError → kExitInput, DeviceError → kExitDevice,
-/// OutputError → kExitOutput, anything else → kExitInternal).
+/// (std::invalid_argument → kExitUsage, InputError and std::filesystem::filesystem_error →
+/// kExitInput, DeviceError → kExitDevice, OutputError → kExitOutput, anything else →
+/// kExitInternal).
 int RunReportingErrors(const std::string& program, const std::function<int()>& body);
 
 }  // namespace ihs

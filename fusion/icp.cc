@@ -11,7 +11,7 @@
 namespace ihs::fusion {
 
 void IcpOptions::Check() const {
-  IHS_CHECK_ARG(iterations >= 1, "icp.iterations must be >= 1");
+  IHS_CHECK_ARG(iterations >= 1 && iterations <= 100, "icp.iterations must be in [1, 100]");
   IHS_CHECK_ARG(max_distance_mm > 0, "icp.max_distance_mm must be positive");
   IHS_CHECK_ARG(min_inlier_fraction >= 0 && min_inlier_fraction <= 1,
                 "icp.min_inlier_fraction must be in [0, 1]");

@@ -16,7 +16,8 @@ void PairwiseOptions::Check() const {
   IHS_CHECK_ARG(visual_weight >= 0, "pairwise.visual_weight must be >= 0");
   IHS_CHECK_ARG(contact_weight > 0 || visual_weight > 0,
                 "pairwise.contact_weight and visual_weight cannot both be 0");
-  IHS_CHECK_ARG(ransac_iterations >= 1, "pairwise.ransac_iterations must be >= 1");
+  IHS_CHECK_ARG(ransac_iterations >= 1 && ransac_iterations <= 100000,
+                "pairwise.ransac_iterations must be in [1, 100000]");
   IHS_CHECK_ARG(inlier_mm > 0, "pairwise.inlier_mm must be positive");
   IHS_CHECK_ARG(min_visual_inliers >= 3, "pairwise.min_visual_inliers must be >= 3");
   IHS_CHECK_ARG(min_contacts >= 3, "pairwise.min_contacts must be >= 3");

@@ -18,9 +18,15 @@
 namespace ihs::fusion {
 
 void ShotOptions::Check() const {
-  IHS_CHECK_ARG(resolution_mm > 0, "shot.resolution_mm must be positive");
-  IHS_CHECK_ARG(normal_radius > 0 && salient_radius > 0 && non_max_radius > 0 && support_radius > 0,
-                "shot radii must be positive");
+  // The cloud is thinned to one point per resolution_mm cube before keypoints are looked for.
+  IHS_CHECK_ARG(resolution_mm >= 0.5 && resolution_mm <= 50,
+                "shot.resolution_mm must be in [0.5, 50]");
+  // Radii in resolutions; a support of r resolutions holds about r² points of a surface each.
+  IHS_CHECK_ARG(normal_radius > 0 && salient_radius > 0 && non_max_radius > 0 &&
+                    support_radius > 0 && normal_radius <= 100 && salient_radius <= 100 &&
+                    non_max_radius <= 100 && support_radius <= 100,
+                "shot.normal_radius, salient_radius, non_max_radius and support_radius must be in "
+                "(0, 100] resolutions");
   IHS_CHECK_ARG(ratio > 0 && ratio < 1, "shot.ratio must be in (0, 1)");
 }
 

@@ -10,7 +10,8 @@
 namespace ihs::fusion {
 
 void SiftOptions::Check() const {
-  IHS_CHECK_ARG(max_features >= 10, "sift.max_features must be >= 10");
+  IHS_CHECK_ARG(max_features >= 10 && max_features <= 100000,
+                "sift.max_features must be in [10, 100000]");
   IHS_CHECK_ARG(ratio > 0 && ratio < 1, "sift.ratio must be in (0, 1)");
 }
 

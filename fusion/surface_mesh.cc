@@ -96,6 +96,9 @@ void MeshingOptions::Check() const {
   IHS_CHECK_ARG(
       poisson_samples_per_node >= 1 && poisson_samples_per_node <= 50,
       "meshing.poisson_samples_per_node must be in [1, 50], got " << poisson_samples_per_node);
+  IHS_CHECK_ARG(poisson_scale >= 1 && poisson_scale <= 4,
+                "meshing.poisson_scale must be in [1, 4] (below 1 the cube cuts the surface), got "
+                    << poisson_scale);
   IHS_CHECK_ARG(bound_voxel_mm >= 0.25 && bound_voxel_mm <= 20,
                 "meshing.bound_voxel_mm must be in [0.25, 20], got " << bound_voxel_mm);
   IHS_CHECK_ARG(bound_keep_seen_mm >= 0 && bound_keep_seen_mm <= 50,

@@ -21,9 +21,11 @@ inline int RoundToInt(float x) { return static_cast<int>(x >= 0 ? x + 0.5f : x -
 }  // namespace
 
 void TsdfOptions::Check() const {
-  IHS_CHECK_ARG(size_mm > 0, "tsdf.size_mm must be positive, got " << size_mm);
-  IHS_CHECK_ARG(resolution >= 8 && resolution <= 1024,
-                "tsdf.resolution must be in [8, 1024], got " << resolution);
+  IHS_CHECK_ARG(size_mm >= 20 && size_mm <= 5000,
+                "tsdf.size_mm must be in [20, 5000] (a hand-held object's cube), got " << size_mm);
+  // 8 bytes a voxel: 512³ voxels take 1 GiB, 1024³ 8 GiB.
+  IHS_CHECK_ARG(resolution >= 8 && resolution <= 512,
+                "tsdf.resolution must be in [8, 512] (512³ voxels take 1 GiB), got " << resolution);
   IHS_CHECK_ARG(truncation_voxels >= 1 && truncation_voxels <= 64,
                 "tsdf.truncation_voxels must be in [1, 64], got " << truncation_voxels);
   IHS_CHECK_ARG(max_weight >= 1 && max_weight <= 65535,

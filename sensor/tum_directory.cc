@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <opencv2/core.hpp>
@@ -27,15 +28,75 @@ struct Stamped {
   std::string path;
 };
 
+// Images of a recording are at most this large, in bytes and in pixels (a 4096 x 4096 frame;
+// no depth camera's is larger): a small file that decodes to gigabytes (a 780 KB PNG of
+// 20000 x 20000 pixels) is refused before decoding.
+constexpr std::uintmax_t kMaxImageBytes = 128ull << 20;
+constexpr std::uint64_t kMaxImagePixels = 4096ull * 4096ull;
+
+std::uint32_t BigEndian(const std::string& bytes, size_t at, int count) {
+  std::uint32_t value = 0;
+  for (int i = 0; i < count; ++i) value = value << 8 | static_cast<unsigned char>(bytes[at + i]);
+  return value;
+}
+
+// The width and height a PNG or JPEG header declares; {0, 0} for other formats (OpenCV's own
+// limits apply to them) or a header too short to say.
+std::pair<std::uint64_t, std::uint64_t> DeclaredSize(const std::string& bytes) {
+  if (bytes.size() >= 24 && bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 &&
+      bytes.compare(12, 4, "IHDR") == 0) {
+    return {BigEndian(bytes, 16, 4), BigEndian(bytes, 20, 4)};
+  }
+  if (bytes.size() >= 4 && static_cast<unsigned char>(bytes[0]) == 0xFF &&
+      static_cast<unsigned char>(bytes[1]) == 0xD8) {
+    // JPEG: walk the segments to the first start-of-frame marker (C0-CF but C4, C8, CC).
+    size_t at = 2;
+    while (at + 9 < bytes.size() && static_cast<unsigned char>(bytes[at]) == 0xFF) {
+      const unsigned marker = static_cast<unsigned char>(bytes[at + 1]);
+      const size_t length = BigEndian(bytes, at + 2, 2);
+      if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
+        return {BigEndian(bytes, at + 7, 2), BigEndian(bytes, at + 5, 2)};
+      at += 2 + length;
+    }
+  }
+  return {0, 0};
+}
+
+// Reads an image of the folder; empty with `*problem` said when it is not a regular file, too
+// large, or does not decode.
+cv::Mat ReadImage(const fs::path& path, int flags, std::string* problem) {
+  std::string bytes;
+  try {
+    bytes = ReadFileToString(path, kMaxImageBytes);
+  } catch (const InputError& error) {
+    *problem = error.what();
+    return {};
+  }
+  const auto [width, height] = DeclaredSize(bytes);
+  if (width * height > kMaxImagePixels) {
+    *problem = path.filename().string() + " declares " + std::to_string(width) + "x" +
+               std::to_string(height) + " pixels, more than a depth camera's frame can have";
+    return {};
+  }
+  cv::Mat image =
+      cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), flags);
+  if (image.empty()) *problem = "cannot decode " + path.filename().string();
+  return image;
+}
+
+// A timestamp a frame can carry: finite, and within ±1e11 s (3000 years; TUM's are Unix
+// seconds, about 1.3e9) so that it fits in microseconds as a 64-bit integer.
+bool UsableTime(double time_s) { return std::isfinite(time_s) && std::abs(time_s) <= 1e11; }
+
 // Parses a TUM list: lines "timestamp path [...]", '#' comments, blank lines ignored.
 std::vector<Stamped> ReadList(const fs::path& file) {
   std::vector<Stamped> list;
   for (const DataLine& line : ReadDataLines(file)) {
     std::istringstream fields(line.text);
     Stamped entry;
-    if (!(fields >> entry.time_s >> entry.path) || !std::isfinite(entry.time_s)) {
+    if (!(fields >> entry.time_s >> entry.path) || !UsableTime(entry.time_s)) {
       throw InputError(file.string() + ": line " + std::to_string(line.number) +
-                       " is not 'timestamp path'");
+                       " is not 'timestamp path' (a timestamp within ±1e11 s)");
     }
     list.push_back(entry);
   }
@@ -50,9 +111,9 @@ std::vector<TumEntry> ReadAssociations(const fs::path& file) {
     std::istringstream fields(line.text);
     double t1, t2;
     std::string p1, p2;
-    if (!(fields >> t1 >> p1 >> t2 >> p2)) {
+    if (!(fields >> t1 >> p1 >> t2 >> p2) || !UsableTime(t1) || !UsableTime(t2)) {
       throw InputError(file.string() + ": line " + std::to_string(line.number) +
-                       " is not 'time path time path'");
+                       " is not 'time path time path' (timestamps within ±1e11 s)");
     }
     // associate.py writes the pair in the order of its arguments: usually rgb, then depth.
     if (LooksLikeDepth(p1) && !LooksLikeDepth(p2)) {
@@ -197,8 +258,9 @@ void TumDirectorySource::Start() {
     intrinsics_ = ReadIntrinsicsFile(folder_ / "intrinsics.txt");
   } else {
     intrinsics_ = CameraIntrinsics::Carmine109();
+    std::string problem;
     const cv::Mat first =
-        cv::imread((folder_ / entries_.front().depth_path).string(), cv::IMREAD_ANYDEPTH);
+        ReadImage(folder_ / entries_.front().depth_path, cv::IMREAD_ANYDEPTH, &problem);
     if (!first.empty() && (first.cols != intrinsics_.width || first.rows != intrinsics_.height)) {
       intrinsics_ = intrinsics_.Scaled(first.cols, first.rows);
     }
@@ -211,15 +273,18 @@ void TumDirectorySource::Start() {
 SourceRead TumDirectorySource::Next(std::chrono::milliseconds) {
   while (next_ < entries_.size()) {
     const TumEntry& entry = entries_[next_++];
-    const cv::Mat depth = cv::imread((folder_ / entry.depth_path).string(), cv::IMREAD_ANYDEPTH);
-    const cv::Mat bgr = cv::imread((folder_ / entry.color_path).string(), cv::IMREAD_COLOR);
-    std::string problem;
+    std::string depth_problem, color_problem, problem;
+    const cv::Mat depth =
+        ReadImage(folder_ / entry.depth_path, cv::IMREAD_ANYDEPTH, &depth_problem);
+    const cv::Mat bgr =
+        depth.empty() ? cv::Mat()
+                      : ReadImage(folder_ / entry.color_path, cv::IMREAD_COLOR, &color_problem);
     if (depth.empty()) {
-      problem = "cannot read depth image " + entry.depth_path;
+      problem = "cannot read depth image " + entry.depth_path + ": " + depth_problem;
     } else if (depth.type() != CV_16UC1) {
       problem = "depth image " + entry.depth_path + " is not a 16-bit single-channel image";
     } else if (bgr.empty()) {
-      problem = "cannot read colour image " + entry.color_path;
+      problem = "cannot read colour image " + entry.color_path + ": " + color_problem;
     } else if (bgr.size() != depth.size()) {
       problem = "colour image " + entry.color_path + " differs in size from its depth image";
     } else if (depth.cols != intrinsics_.width || depth.rows != intrinsics_.height) {

@@ -9,8 +9,11 @@
 namespace ihs::tracker {
 
 void ContactOptions::Check() const {
-  IHS_CHECK_ARG(start_mm > 0 && step_mm > 0 && max_mm >= start_mm,
-                "contacts: start_mm and step_mm must be positive and max_mm >= start_mm");
+  IHS_CHECK_ARG(start_mm > 0 && step_mm > 0 && max_mm >= start_mm && max_mm <= 100,
+                "contacts: start_mm and step_mm must be positive and start_mm <= max_mm <= 100");
+  // Detect counts once per threshold: the thresholds between start_mm and max_mm are bounded.
+  IHS_CHECK_ARG((max_mm - start_mm) / step_mm <= 1000,
+                "contacts.step_mm must be at least (max_mm - start_mm) / 1000");
   IHS_CHECK_ARG(min_vertices >= 1 && reference_fingertip_vertices >= 1,
                 "contacts.min_vertices and reference_fingertip_vertices must be >= 1");
   IHS_CHECK_ARG(min_bones >= 1 && min_bones <= 5, "contacts.min_bones must be in [1, 5]");

@@ -261,12 +261,14 @@ bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
 
 void HandFitOptions::Check() const {
   IHS_CHECK_ARG(collision_weight >= 0, "hand_fit.collision_weight must be >= 0");
-  IHS_CHECK_ARG(outer_iterations >= 1 && inner_iterations >= 1,
-                "hand_fit.outer_iterations and inner_iterations must be >= 1");
+  IHS_CHECK_ARG(outer_iterations >= 1 && outer_iterations <= 100 && inner_iterations >= 1 &&
+                    inner_iterations <= 100,
+                "hand_fit.outer_iterations and inner_iterations must be in [1, 100]");
   IHS_CHECK_ARG(inner_function_tolerance > 0 && inner_function_tolerance < 1,
                 "hand_fit.inner_function_tolerance must be in (0, 1)");
-  IHS_CHECK_ARG(max_data_points >= 10 && max_model_points >= 10,
-                "hand_fit.max_data_points and max_model_points must be >= 10");
+  IHS_CHECK_ARG(max_data_points >= 10 && max_data_points <= 100000 && max_model_points >= 10 &&
+                    max_model_points <= 100000,
+                "hand_fit.max_data_points and max_model_points must be in [10, 100000]");
   IHS_CHECK_ARG(max_correspondence_mm > 0 && robust_scale_mm > 0,
                 "hand_fit.max_correspondence_mm and robust_scale_mm must be positive");
   IHS_CHECK_ARG(limit_weight >= 0 && prior_weight >= 0,

@@ -57,9 +57,13 @@ void TrackerOptions::Check() const {
                 "tracker.search_candidates must be in [1, 1000]");
   IHS_CHECK_ARG(search_refined >= 1 && search_refined <= 100,
                 "tracker.search_refined must be in [1, 100]");
-  IHS_CHECK_ARG(scale_frames >= 0, "tracker.scale_frames must be >= 0");
+  // Each of the first scale_frames frames is fitted at every scale tried (2 range / step + 1).
+  IHS_CHECK_ARG(scale_frames >= 0 && scale_frames <= 300,
+                "tracker.scale_frames must be in [0, 300]");
   IHS_CHECK_ARG(scale_range >= 0 && scale_range < 0.5, "tracker.scale_range must be in [0, 0.5)");
-  IHS_CHECK_ARG(scale_step > 0, "tracker.scale_step must be positive");
+  IHS_CHECK_ARG(scale_step > 0 && scale_range <= 50 * scale_step,
+                "tracker.scale_step must be positive and at least scale_range / 50 (at most 101 "
+                "scales tried)");
 }
 
 namespace {

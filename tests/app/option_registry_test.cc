@@ -5,6 +5,9 @@
 #include "app/option_registry.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cctype>
 
 #include "app/scanner_options.h"
 #include "core/errors.h"
@@ -135,6 +138,88 @@ TEST(OptionRegistryTest, ScannerOptionsCheckNamesTheBadField) {
   nothing_to_register.scan.features_2d = false;
   nothing_to_register.fusion.pairwise.contact_weight = 0;
   EXPECT_THROW(nothing_to_register.Check(), std::invalid_argument);
+}
+
+TEST(OptionRegistryTest, NonFiniteNumbersAreRefusedByEveryNumericOption) {
+  ScannerOptions options;
+  OptionRegistry registry = RegisterScannerOptions(&options);
+  int numeric = 0;
+  for (const std::string& name : registry.Names()) {
+    const std::string value = registry.Get(name);
+    if (value.empty() || !(std::isdigit(static_cast<unsigned char>(value[0])) || value[0] == '-'))
+      continue;  // bool or text
+    const bool vector = value.find(',') != std::string::npos;
+    ++numeric;
+    for (const std::string bad : {"nan", "inf", "-inf", "1e400", "-1e400"}) {
+      const std::string text = vector ? bad + ",0,0" : bad;
+      EXPECT_THROW(registry.Set(name, text), std::invalid_argument) << name << " = " << text;
+      EXPECT_EQ(registry.Get(name), value) << name << " changed by " << text;
+    }
+  }
+  EXPECT_GT(numeric, 80);
+}
+
+// Values the options' types accept but whose memory or time would have no bound (each was
+// accepted once: > 6 GB, or a loop that never ends) are refused by Check(), naming the option.
+TEST(OptionRegistryTest, ValuesThatWouldExhaustMemoryOrTimeAreRefused) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"tracker.contacts.step_mm", "1e-300"},
+      {"tracker.contacts.max_mm", "1e300"},
+      {"tracker.fit.outer_iterations", "2147483647"},
+      {"tracker.fit.inner_iterations", "100000"},
+      {"tracker.fit.max_data_points", "2147483647"},
+      {"tracker.scale_step", "1e-6"},
+      {"tracker.scale_frames", "100000"},
+      {"fusion.tsdf.resolution", "1024"},
+      {"fusion.tsdf.size_mm", "1e308"},
+      {"fusion.tsdf.size_mm", "1e-300"},
+      {"fusion.icp.iterations", "1000000"},
+      {"fusion.pairwise.ransac_iterations", "2000000000"},
+      {"features.sift.max_features", "2147483647"},
+      {"features.shot.resolution_mm", "1e-300"},
+      {"features.shot.support_radius", "1e300"},
+      {"mesh.poisson_scale", "-1"},
+      {"mesh.poisson_scale", "0.5"},
+      {"mesh.poisson_depth", "20"},
+  };
+  for (const auto& [name, value] : cases) {
+    ScannerOptions options;
+    OptionRegistry registry = RegisterScannerOptions(&options);
+    try {
+      registry.Set(name, value);
+    } catch (const std::invalid_argument&) {
+      continue;  // Not even of the field's type ("1e9" for an int): refused already.
+    }
+    const std::string field = name.substr(name.rfind('.') + 1);
+    try {
+      options.Check();
+      ADD_FAILURE() << name << " = " << value << " was accepted";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find(field), std::string::npos)
+          << name << ": " << error.what();
+    }
+  }
+}
+
+TEST(OptionRegistryTest, ConfigsThatAreNotRegularFilesOrAreHugeAreRefusedWithoutReading) {
+  test::TempDir dir;
+  Fields f;
+  OptionRegistry r = Register(&f);
+  // A FIFO nobody writes to would block a reader for ever; a folder reads as nothing; /dev/zero
+  // never ends.
+  ASSERT_EQ(mkfifo((dir / "fifo").c_str(), 0600), 0);
+  EXPECT_THROW(r.Load(dir / "fifo"), InputError);
+  EXPECT_THROW(r.Load(dir.path()), InputError);
+  EXPECT_THROW(r.Load("/dev/zero"), InputError);
+  test::WriteBytes(dir / "huge.conf",
+                   std::string(OptionRegistry::kMaxConfigBytes, '#') + "\nseed = 3\n");
+  try {
+    r.Load(dir / "huge.conf");
+    FAIL() << "a config over the size cap was read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("huge.conf"), std::string::npos) << error.what();
+  }
+  EXPECT_EQ(f.seed, 1u);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #include "sensor/tum_directory.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <chrono>
 #include <filesystem>
@@ -93,6 +94,25 @@ TEST(TumDirectoryTest, UnreadableImagesAreSkippedAndCounted) {
   EXPECT_EQ(frames[1]->index, 1);  // Indices count delivered frames.
 }
 
+TEST(TumDirectoryTest, ImagesThatAreNotFilesOrDeclareHugeSizesAreSkippedUndecoded) {
+  test::TempDir dir;
+  WriteFrames(dir.path(), test::MakePatternFrames(4, 16, 12), CameraIntrinsics{}.Scaled(16, 12));
+  const auto entries = ListTumDirectory(dir.path(), TumOptions{});
+  // A FIFO in place of a depth image would block a reader for ever.
+  std::filesystem::remove(dir / entries[1].depth_path);
+  ASSERT_EQ(mkfifo((dir / entries[1].depth_path).c_str(), 0600), 0);
+  // A valid PNG whose header says 20000 x 20000 pixels (1.2 GB decoded): patched IHDR.
+  std::string png = test::ReadFileString(dir / entries[2].depth_path);
+  ASSERT_EQ(png.substr(12, 4), "IHDR");
+  const char huge[8] = {0, 0, 0x4e, 0x20, 0, 0, 0x4e, 0x20};
+  png.replace(16, 8, huge, 8);
+  test::WriteBytes(dir / entries[2].color_path, png);
+  TumDirectorySource source(dir.path());
+  const auto frames = test::ReadAllFrames(source);
+  EXPECT_EQ(frames.size(), 2u);
+  EXPECT_EQ(source.SkippedFrames(), 2);
+}
+
 TEST(TumDirectoryTest, BadFoldersAndListsAreInputErrors) {
   test::TempDir dir;
   EXPECT_THROW(TumDirectorySource(dir / "missing").Start(), InputError);
@@ -106,6 +126,12 @@ TEST(TumDirectoryTest, BadFoldersAndListsAreInputErrors) {
     EXPECT_NE(std::string(error.what()).find("rgb.txt: line 1"), std::string::npos) << error.what();
   }
   test::WriteBytes(dir / "rgb.txt", "5.0 rgb/a.png\n");  // Nothing within 20 ms.
+  EXPECT_THROW(TumDirectorySource(dir.path()).Start(), InputError);
+  // A timestamp whose microseconds overflow 64 bits (it became INT64_MIN in trajectory.txt).
+  test::WriteBytes(dir / "depth.txt", "1e13 depth/a.png\n");
+  test::WriteBytes(dir / "rgb.txt", "1e13 rgb/a.png\n");
+  EXPECT_THROW(TumDirectorySource(dir.path()).Start(), InputError);
+  test::WriteBytes(dir / "associations.txt", "1.0 rgb/a.png 1e13 depth/a.png\n");
   EXPECT_THROW(TumDirectorySource(dir.path()).Start(), InputError);
 }
 
