@@ -378,6 +378,11 @@ void OniFileSource::Start() {
 
 void OniFileSource::Stop() { mapping_.reset(); }
 
+bool OniFileSource::DecodesDepthCodec() const {
+  return depth_ && (depth_->codec == kOniCodecNone || depth_->codec == kOniCodec16z ||
+                    depth_->codec == kOniCodec16zT);
+}
+
 SourceRead OniFileSource::Next(std::chrono::milliseconds) {
   IHS_CHECK(mapping_ != nullptr, "OniFileSource::Next called before Start");
   const std::string_view bytes = mapping_->bytes();

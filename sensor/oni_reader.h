@@ -104,6 +104,8 @@ class OniFileSource : public FrameSource {
 
   /// The index of the file (valid after Start()).
   const OniIndex& index() const { return index_; }
+  /// Whether this reader decodes the depth stream's codec (NONE, 16zP, 16zT; valid after Start()).
+  bool DecodesDepthCodec() const;
 
  private:
   struct Mapping;

@@ -13,37 +13,33 @@
 namespace ihs::sensor {
 namespace {
 
-// Plays an .oni file with OpenNI2's player and falls back to the project's own reader when
-// OpenNI2 refuses the file (OpenNI2 rejects truncated recordings outright).
+// Plays an .oni file with the project's own reader. OpenNI2's player gets a file only when our
+// reader has indexed it end to end (every record's header and size checked, nothing damaged)
+// and it holds a depth codec only OpenNI2 decodes: OpenNI2's file driver trusts the sizes and
+// names in the file, and one changed byte crashes it (a heap overflow) in our process.
 class AutoOniSource : public FrameSource {
  public:
   AutoOniSource(std::string path, Pacing pacing) : path_(std::move(path)), pacing_(pacing) {}
 
   void Start() override {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path_, ec)) {
-      throw InputError(path_ + ": no such file");
-    }
-    OpenNiOptions options;
-    options.uri = path_;
-    auto openni = std::make_unique<OpenNiSource>(options);
-    try {
-      openni->Start();
-    } catch (const InputError& openni_error) {
-      spdlog::debug("{}; trying the built-in .oni reader", openni_error.what());
-      openni.reset();
-    }
-    if (openni && openni->FrameCount()) {
-      active_ = WithPacing(std::move(openni), pacing_);
+    auto own = std::make_unique<OniFileSource>(path_);
+    own->Start();  // Throws its own InputError when nothing can be recovered.
+    if (own->DecodesDepthCodec()) {
+      active_ = WithPacing(std::move(own), pacing_);
+      active_->Start();  // Our reader again (indexing is quick), under the pacing's own Start.
       return;
     }
-    if (openni) {
-      // No frame count: an unfinished recording, whose complete frames our reader knows exactly.
-      spdlog::debug("{}: OpenNI2 reports no frame count; using the built-in .oni reader", path_);
-      openni->Stop();
+    if (!own->index().complete) {
+      throw InputError(
+          path_ + ": damaged recording (" + own->index().damage +
+          ") in a depth codec only OpenNI2 decodes; OpenNI2 is not given damaged files");
     }
-    active_ = WithPacing(std::make_unique<OniFileSource>(path_), pacing_);
-    active_->Start();  // Throws its own InputError when nothing can be recovered.
+    own->Stop();
+    spdlog::info("{}: a depth codec the built-in reader lacks; playing it with OpenNI2", path_);
+    OpenNiOptions options;
+    options.uri = path_;
+    active_ = WithPacing(std::make_unique<OpenNiSource>(options), pacing_);
+    active_->Start();
   }
   void Stop() override {
     if (active_) active_->Stop();

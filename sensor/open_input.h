@@ -11,7 +11,8 @@ namespace ihs::sensor {
 
 /// Which reader plays .oni files.
 enum class OniBackend {
-  kAuto,       ///< OpenNI2's player; the project's own reader when OpenNI2 refuses the file.
+  kAuto,       ///< The project's own reader; OpenNI2's player only for a file our reader indexed
+               ///< undamaged whose depth codec only OpenNI2 decodes.
   kOpenNi,     ///< OpenNI2's player only.
   kOwnReader,  ///< The project's own reader only (recovers truncated recordings).
 };
