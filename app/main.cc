@@ -43,7 +43,8 @@ std::atomic<bool> g_export_signal{false};
 static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free);
 
 void OnStopSignal(int) {
-  // The first SIGINT/SIGTERM finishes the scan (frames in hand, export); a second exits at once.
+  // The first SIGINT/SIGTERM/SIGHUP finishes the scan (frames in hand, export); a second exits at
+  // once.
   if (g_stop_signals.fetch_add(1) >= 1) _exit(130);
 }
 
@@ -55,6 +56,7 @@ void InstallSignalHandlers() {
   action.sa_handler = OnStopSignal;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGHUP, &action, nullptr);  // A closed terminal must not lose the scan.
   action.sa_handler = OnExportSignal;
   sigaction(SIGUSR1, &action, nullptr);
 }

@@ -155,6 +155,9 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
     throw OutputError(output_.folder.string() + ": cannot create the output folder" +
                       (error ? " (" + error.message() + ")" : ""));
   }
+  if (const int removed = RemovePreviousScan(output_.folder)) {
+    spdlog::info("{}: removed {} files of an earlier scan", output_.folder.string(), removed);
+  }
   if (options_.pipeline.preview_every > 0) {
     std::filesystem::create_directories(output_.folder / "preview", error);
   }
@@ -506,10 +509,18 @@ PipelineResult Pipeline::Finish() {
   if (s.failure) {
     result.exit_code = ExitCodeOf(s.failure);
     result.error = s.failed_stage + ": " + MessageOf(s.failure);
-    if (result.files.empty())
+    // What is in the folder now was written by this scan (an earlier one's files were removed
+    // when it started), the final export's or an earlier export's.
+    std::string saved;
+    for (const std::filesystem::path& file : ScanFilesIn(output_.folder))
+      saved += (saved.empty() ? "" : ", ") + file.filename().string();
+    if (saved.empty()) {
       result.error += " (nothing could be saved)";
-    else
-      result.error += " (the model so far was saved)";
+    } else if (std::filesystem::exists(output_.folder / "mesh.ply")) {
+      result.error += " (the model so far was saved: " + saved + ")";
+    } else {
+      result.error += " (no mesh could be saved; saved: " + saved + ")";
+    }
   } else if (result.progress.captured == 0) {
     result.exit_code = kExitInput;
     result.error = source_->Description() + ": no frames";

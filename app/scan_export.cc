@@ -1,5 +1,6 @@
 #include "app/scan_export.h"
 
+#include "core/errors.h"
 #include "core/mesh_io.h"
 #include "core/stopwatch.h"
 
@@ -28,6 +29,43 @@ ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
   }
   exported.milliseconds = MillisecondsSince(start);
   return exported;
+}
+
+namespace {
+
+constexpr const char* kScanFiles[] = {"mesh.ply",       "mesh_tsdf.ply",  "mesh.obj",
+                                      "mesh.stl",       "trajectory.txt", "hand_joints.csv",
+                                      "hand_poses.csv", "stats.json"};
+
+}  // namespace
+
+std::vector<std::filesystem::path> ScanFilesIn(const std::filesystem::path& folder) {
+  std::vector<std::filesystem::path> found;
+  std::error_code error;
+  for (const char* name : kScanFiles) {
+    if (std::filesystem::is_regular_file(folder / name, error)) found.push_back(folder / name);
+  }
+  return found;
+}
+
+int RemovePreviousScan(const std::filesystem::path& folder) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> stale = ScanFilesIn(folder);
+  std::error_code error;
+  if (fs::is_directory(folder / "preview", error)) {
+    for (const fs::directory_entry& entry : fs::directory_iterator(folder / "preview", error)) {
+      if (entry.path().extension() == ".png") stale.push_back(entry.path());
+    }
+  }
+  int removed = 0;
+  for (const fs::path& path : stale) {
+    if (!fs::remove(path, error) || error) {
+      throw OutputError(path.string() + ": cannot remove the earlier scan's file (" +
+                        error.message() + ")");
+    }
+    ++removed;
+  }
+  return removed;
 }
 
 }  // namespace ihs::app

@@ -32,4 +32,15 @@ ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
                             const std::filesystem::path& folder,
                             const std::vector<std::string>& extra_formats = {});
 
+/// The files a scan writes that are in `folder` now (see RemovePreviousScan for the names;
+/// previews not included), in that order.
+std::vector<std::filesystem::path> ScanFilesIn(const std::filesystem::path& folder);
+
+/// Removes from `folder` the files an earlier scan wrote there (mesh.ply, mesh_tsdf.ply,
+/// mesh.obj, mesh.stl, trajectory.txt, hand_joints.csv, hand_poses.csv, stats.json and the PNGs
+/// in preview/), so that a new scan into the same folder never leaves an old mesh beside its own
+/// stats.json; other files stay. Returns how many were removed. Throws ihs::OutputError when one
+/// cannot be removed.
+int RemovePreviousScan(const std::filesystem::path& folder);
+
 }  // namespace ihs::app

@@ -91,6 +91,9 @@ int Run(const Args& args) {
   std::error_code error;
   fs::create_directories(out, error);
   if (error) throw ihs::OutputError(out.string() + ": cannot create (" + error.message() + ")");
+  if (const int removed = ihs::app::RemovePreviousScan(out)) {
+    spdlog::info("{}: removed {} files of an earlier scan", out.string(), removed);
+  }
 
   std::int64_t index = 0;
   std::vector<ihs::eval::FrameContactUse> contact_use;

@@ -1,6 +1,6 @@
 // The inhandscan executable as a user drives it: help and exit codes, options and config files,
 // a missing input or device, and signals during a replay (SIGUSR1 exports and the scan goes on;
-// SIGINT finishes, exports and exits 0).
+// SIGINT and SIGHUP finish, export and exit 0).
 
 #include <gtest/gtest.h>
 
@@ -115,7 +115,14 @@ TEST(InhandscanTest, RecordingsWithoutAHandScanNothingAndSaySo) {
     }
     writer.Close();
   }
+  // Into a folder an earlier scan wrote: its mesh must not stay beside the new stats.json.
+  fs::create_directories(dir / "ball" / "preview");
+  for (const char* name : {"mesh.ply", "stats.json", "preview/000030.png", "notes.txt"})
+    test::WriteBytes(dir / "ball" / name, "from an earlier scan");
   ExpectNothingScannedForWantOfAHand(dir / "ball.oni", dir / "ball");
+  EXPECT_FALSE(fs::exists(dir / "ball" / "preview" / "000030.png"));
+  EXPECT_NE(test::ReadFileString(dir / "ball" / "stats.json"), "from an earlier scan");
+  EXPECT_TRUE(fs::exists(dir / "ball" / "notes.txt"));  // Not a scan's file: left alone.
   // The real Kinect recording of a room.
   const fs::path real = test::KinectRecording();
   if (real.empty()) GTEST_SKIP() << "no shared data: the real recording's case is left out";
@@ -192,16 +199,19 @@ TEST_F(InhandscanSignalTest, ReplayWritesEveryOutputAndTheFormatsAskedFor) {
   EXPECT_FALSE(fs::is_empty(out / "preview"));
 }
 
-TEST_F(InhandscanSignalTest, SigintFinishesExportsAndExitsZero) {
-  const test::TempDir dir;
-  const fs::path out = dir / "scan";  // Made by the program.
-  const auto run = ReplayWithSignal(out, "INT", 1.5);
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_NE(run.out.find("mesh: "), std::string::npos) << run.out;
-  const auto stats = nlohmann::json::parse(test::ReadFileString(out / "stats.json"));
-  EXPECT_EQ(stats["summary"]["end_reason"], "stopped");
-  EXPECT_LT(stats["summary"]["captured_frames"].get<int>(), 90);
-  EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
+// SIGINT (Ctrl-C) and SIGHUP (the terminal closed) both end the scan with its model saved.
+TEST_F(InhandscanSignalTest, SigintAndSighupFinishExportAndExitZero) {
+  for (const char* signal : {"INT", "HUP"}) {
+    const test::TempDir dir;
+    const fs::path out = dir / "scan";  // Made by the program.
+    const auto run = ReplayWithSignal(out, signal, 1.5);
+    ASSERT_EQ(run.exit_code, 0) << signal << ": " << run.err;
+    EXPECT_NE(run.out.find("mesh: "), std::string::npos) << signal << ": " << run.out;
+    const auto stats = nlohmann::json::parse(test::ReadFileString(out / "stats.json"));
+    EXPECT_EQ(stats["summary"]["end_reason"], "stopped") << signal;
+    EXPECT_LT(stats["summary"]["captured_frames"].get<int>(), 90) << signal;
+    EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty()) << signal;
+  }
 }
 
 }  // namespace
