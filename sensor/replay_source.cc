@@ -8,6 +8,19 @@
 
 namespace ihs::sensor {
 
+void FrameGate::Open() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_ = true;
+  }
+  opened_.notify_all();
+}
+
+bool FrameGate::WaitUntil(std::chrono::steady_clock::time_point deadline) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  return opened_.wait_until(lock, deadline, [this] { return open_; });
+}
+
 ReplaySource::ReplaySource(std::vector<Frame> frames, const CameraIntrinsics& intrinsics,
                            FaultPlan faults, bool live)
     : frames_(std::move(frames)), intrinsics_(intrinsics), faults_(std::move(faults)), live_(live) {
@@ -28,6 +41,7 @@ void ReplaySource::Start() {
   next_index_ = 0;
   previous_.reset();
   stalled_.reset();
+  stalled_gate_.reset();
 }
 
 void ReplaySource::Stop() {
@@ -47,6 +61,11 @@ SourceRead ReplaySource::Next(std::chrono::milliseconds timeout) {
   IHS_CHECK(started_, "ReplaySource::Next called before Start");
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (true) {
+    if (stalled_ && stalled_gate_) {
+      if (!stalled_gate_->WaitUntil(deadline)) return {SourceStatus::kTimeout, {}, ""};
+      stalled_gate_.reset();
+      return {SourceStatus::kFrame, std::exchange(stalled_, nullptr), ""};
+    }
     if (stalled_) {
       const auto now = std::chrono::steady_clock::now();
       const auto release = std::min(stalled_until_, deadline);
@@ -82,6 +101,11 @@ SourceRead ReplaySource::Next(std::chrono::milliseconds timeout) {
     if (faults_.wrong_size.count(index)) frame.depth_mm.resize(frame.depth_mm.size() / 2);
 
     auto shared = std::make_shared<const Frame>(std::move(frame));
+    if (auto gate = faults_.held.find(index); gate != faults_.held.end() && gate->second) {
+      stalled_ = std::move(shared);
+      stalled_gate_ = gate->second;
+      continue;
+    }
     if (auto stall = faults_.stall_ms.find(index); stall != faults_.stall_ms.end()) {
       stalled_ = std::move(shared);
       stalled_until_ = std::chrono::steady_clock::now() + std::chrono::milliseconds(stall->second);

@@ -4,9 +4,11 @@
 // or recording misbehaves.
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -16,6 +18,20 @@
 
 namespace ihs::sensor {
 
+/// A gate a test opens: a frame held at it is delivered only once it is open, so that a test can
+/// act while the scan is known to wait (no sleeps that decide the order). Thread-safe.
+class FrameGate {
+ public:
+  void Open();
+  /// Waits until the gate is open or `deadline` passes; whether it is open.
+  bool WaitUntil(std::chrono::steady_clock::time_point deadline);
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable opened_;
+  bool open_ = false;
+};
+
 /// Faults to inject, keyed by the 0-based index of the frame in the underlying stream.
 struct FaultPlan {
   /// Frames never delivered (as a sensor that drops frames).
@@ -24,6 +40,9 @@ struct FaultPlan {
   std::set<std::int64_t> duplicate_timestamp;
   /// Frames delivered only after a stall of this many milliseconds.
   std::map<std::int64_t, int> stall_ms;
+  /// Frames delivered only once their gate is open (Next() meanwhile times out as a stalled
+  /// sensor does, so a stop is still noticed).
+  std::map<std::int64_t, std::shared_ptr<FrameGate>> held;
   /// After this many frames have been read from the underlying stream, report kDisconnected.
   std::optional<std::int64_t> disconnect_after;
   /// Frames delivered with a depth image of the wrong size (fails Frame::Check).
@@ -68,9 +87,10 @@ class ReplaySource : public FrameSource {
   std::int64_t next_index_ = 0;  // Index of the next underlying frame.
   std::int64_t missed_ = 0;      // Frames dropped by the fault plan.
   std::optional<Frame> previous_;
-  // A frame held back by a stall, and when it may be delivered.
+  // A frame held back by a stall or a gate, and when it may be delivered.
   std::shared_ptr<const Frame> stalled_;
   std::chrono::steady_clock::time_point stalled_until_;
+  std::shared_ptr<FrameGate> stalled_gate_;
 };
 
 }  // namespace ihs::sensor

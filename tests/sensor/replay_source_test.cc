@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <thread>
 
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
@@ -72,6 +73,22 @@ TEST(ReplaySourceTest, StallTimesOutThenDeliversTheFrame) {
   ASSERT_EQ(late.status, SourceStatus::kFrame);
   EXPECT_EQ(late.frame->index, 1);
   EXPECT_GE(std::chrono::steady_clock::now() - start, 115ms);
+}
+
+TEST(ReplaySourceTest, AHeldFrameComesOnlyOnceItsGateOpens) {
+  FaultPlan faults;
+  const auto gate = std::make_shared<FrameGate>();
+  faults.held[1] = gate;
+  ReplaySource source(test::MakePatternFrames(3, 32, 24), CameraIntrinsics{}, faults);
+  source.Start();
+  ASSERT_EQ(source.Next(0ms).status, SourceStatus::kFrame);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(source.Next(10ms).status, SourceStatus::kTimeout);
+  std::thread opener([&] { gate->Open(); });
+  const SourceRead held = source.Next(60s);  // Returns as soon as the gate opens.
+  opener.join();
+  ASSERT_EQ(held.status, SourceStatus::kFrame);
+  EXPECT_EQ(held.frame->index, 1);
+  EXPECT_EQ(source.Next(0ms).frame->index, 2);
 }
 
 TEST(ReplaySourceTest, WrapsAnotherSourceAndCountsItsFrames) {
