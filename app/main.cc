@@ -10,14 +10,17 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "app/live_screen.h"
 #include "app/pipeline.h"
+#include "app/scan_export.h"
 #include "app/scanner_options.h"
 #include "core/allocator.h"
 #include "core/command_line.h"
@@ -136,13 +139,61 @@ class ProgressReporter {
   double last_log_s_ = 0;
 };
 
+// A stop whose frames in hand did not finish within the grace: once the model so far is exported
+// without them (or the export itself is stuck), says what was saved and exits at once, leaving
+// the stuck thread behind (joining it would wait for ever).
+class StopGuard {
+ public:
+  StopGuard(Pipeline& pipeline, const fs::path& folder, double grace_s)
+      : pipeline_(pipeline), folder_(folder), grace_(std::chrono::duration<double>(grace_s)) {}
+
+  void Check(bool stop_sent) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!stop_sent) return;
+    if (!stopped_at_) stopped_at_ = now;
+    if (!abandoned_at_ && now - *stopped_at_ > grace_) {
+      spdlog::warn("a stage has not finished its frame {:.0f} s after the stop", grace_.count());
+      pipeline_.Abandon();
+      abandoned_at_ = now;
+    }
+    if (!abandoned_at_) return;
+    // The final export itself takes seconds (Poisson); only a fusion thread stuck in its own
+    // frame never gets to it.
+    const bool exported = pipeline_.WaitForFinalExport(std::chrono::milliseconds(0));
+    if (!exported && now - *abandoned_at_ <= grace_ + kExportWait) return;
+    std::string saved;
+    for (const fs::path& file : ihs::app::ScanFilesIn(folder_))
+      saved += (saved.empty() ? "" : ", ") + file.filename().string();
+    std::fprintf(stderr, "inhandscan: error: %s\n",
+                 ihs::OneLine("a stage did not finish its frame after the stop; " +
+                              (saved.empty() ? std::string("nothing could be saved")
+                                             : "the model so far was saved without the frames "
+                                               "in hand: " +
+                                                   saved))
+                     .c_str());
+    if (fs::exists(folder_ / "mesh.ply")) std::printf("mesh: %s\n", (folder_ / "mesh.ply").c_str());
+    std::fflush(stdout);
+    std::fflush(stderr);
+    std::_Exit(ihs::kExitStageFailed);
+  }
+
+ private:
+  Pipeline& pipeline_;
+  const fs::path folder_;
+  const std::chrono::duration<double> grace_;
+  std::optional<std::chrono::steady_clock::time_point> stopped_at_, abandoned_at_;
+  static constexpr std::chrono::seconds kExportWait{300};
+};
+
 // Runs a pipeline to its end: signals (and the window's keys) become requests; returns the
 // exit code after printing where the mesh is.
 int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
-                ihs::render::LiveWindow* window, const std::string& screenshot, bool quiet) {
+                ihs::render::LiveWindow* window, const std::string& screenshot, bool quiet,
+                StopGuard& guard) {
   ProgressReporter reporter;
   bool stop_sent = false;
   while (!pipeline.Wait(std::chrono::milliseconds(window ? 15 : 100))) {
+    guard.Check(stop_sent);
     if (g_export_signal.exchange(false)) {
       spdlog::info("export requested");
       pipeline.RequestExport();
@@ -201,6 +252,7 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   output.folder = args.out.empty() ? DefaultOutputFolder() : args.out;
   output.extra_formats = args.formats;
   output.live_view = want_window;
+  const double stop_grace_s = options.pipeline.stop_grace_s;
   Pipeline pipeline(std::move(source), std::move(options), output);
   pipeline.Start();
   std::unique_ptr<ihs::render::LiveWindow> window;
@@ -214,7 +266,8 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   }
   spdlog::info("scanning into {} (export now: kill -USR1 {}; stop: Ctrl-C)", output.folder.string(),
                getpid());
-  return RunPipeline(pipeline, pipeline.intrinsics(), window.get(), args.screenshot, quiet);
+  StopGuard guard(pipeline, output.folder, stop_grace_s);
+  return RunPipeline(pipeline, pipeline.intrinsics(), window.get(), args.screenshot, quiet, guard);
 }
 
 }  // namespace

@@ -127,7 +127,8 @@ struct Pipeline::Shared {
   std::string failed_stage;
   std::exception_ptr failure;
   std::vector<std::filesystem::path> final_files;
-  int running = 0;  // Threads still running.
+  bool export_done = false;  // The export thread has ended (the final export written or failed).
+  int running = 0;           // Threads still running.
 };
 
 Pipeline::Pipeline(std::unique_ptr<sensor::FrameSource> source, ScannerOptions options,
@@ -314,7 +315,15 @@ void Pipeline::FusionLoop() {
           submit(ExportJob::Kind::kExport, nullptr)) {
         export_requested_.store(false);
       }
-      if (status == PopStatus::kTimeout) continue;
+      if (status == PopStatus::kTimeout) {
+        if (!abandon_requested_.load()) continue;
+        spdlog::warn(
+            "the frames in hand did not finish after the stop: the model so far is "
+            "exported without them");
+        std::lock_guard<std::mutex> lock(s.mutex);
+        if (s.end_reason.empty()) s.end_reason = "stopped, frames in hand left behind";
+        break;
+      }
       if (status == PopStatus::kClosed) break;
       object->Process(*packet);
       packet->latency_ms = MillisecondsSince(packet->captured_at);
@@ -459,6 +468,10 @@ void Pipeline::ExportLoop() {
       Fail("export", std::current_exception());
     }
   }
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.export_done = true;
+  }
   ThreadDone();
 }
 
@@ -466,6 +479,12 @@ bool Pipeline::Wait(std::chrono::milliseconds timeout) {
   if (!started_) return true;
   std::unique_lock<std::mutex> lock(shared_->mutex);
   return shared_->done.wait_for(lock, timeout, [this] { return shared_->running == 0; });
+}
+
+bool Pipeline::WaitForFinalExport(std::chrono::milliseconds timeout) {
+  if (!started_) return true;
+  std::unique_lock<std::mutex> lock(shared_->mutex);
+  return shared_->done.wait_for(lock, timeout, [this] { return shared_->export_done; });
 }
 
 PipelineProgress Pipeline::Progress() const {

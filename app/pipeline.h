@@ -115,6 +115,13 @@ class Pipeline {
   void RequestStop() { stop_requested_.store(true); }
   /// Asks for the model to be discarded and the scan to start anew ('r' in the live window).
   void RequestReset() { reset_requested_.store(true); }
+  /// For a stop whose frames in hand do not finish (a source read or a stage that does not
+  /// return): the fusion thread stops waiting for them and the final export saves the model
+  /// so far without them. The stuck thread still runs; Finish() would wait for it, so a program
+  /// that cannot wait exits after WaitForFinalExport(). Safe from any thread.
+  void Abandon() { abandon_requested_.store(true); }
+  /// Waits up to `timeout` for the final export to be done (written, or failed); true when it is.
+  bool WaitForFinalExport(std::chrono::milliseconds timeout);
   /// Waits up to `timeout` for every thread to finish; true when they have.
   bool Wait(std::chrono::milliseconds timeout);
   /// Joins the threads (stopping them if asked to) and says how the scan ended.
@@ -144,6 +151,7 @@ class Pipeline {
   std::atomic<bool> export_requested_{false};
   std::atomic<bool> stop_requested_{false};
   std::atomic<bool> reset_requested_{false};
+  std::atomic<bool> abandon_requested_{false};
   LatestValue<LiveView> live_view_;
   std::vector<std::thread> threads_;
   bool started_ = false;

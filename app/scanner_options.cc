@@ -20,6 +20,8 @@ void PipelineOptions::Check() const {
                 "pipeline.queue_capacity must be in [1, 1000]");
   IHS_CHECK_ARG(preview_every >= 0, "pipeline.preview_every must be ≥ 0");
   IHS_CHECK_ARG(max_frames >= 0, "pipeline.max_frames must be ≥ 0");
+  IHS_CHECK_ARG(stop_grace_s >= 1 && stop_grace_s <= 3600,
+                "pipeline.stop_grace_s must be in [1, 3600]");
 }
 
 void ScannerOptions::Check() const {
@@ -253,6 +255,9 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("pipeline.preview_every", &p.preview_every,
         "write a preview image every this many fused frames (0: never)");
   r.Add("pipeline.max_frames", &p.max_frames, "stop after this many frames (0: all)");
+  r.Add("pipeline.stop_grace_s", &p.stop_grace_s,
+        "seconds the frames in hand get after a stop before a stage still busy is left behind "
+        "and the model so far is exported without them (exit 5)");
   return r;
 }
 

@@ -55,6 +55,11 @@ struct PipelineOptions {
   int preview_every = 30;
   /// Frames the capture thread reads at most (0: all).
   int max_frames = 0;
+  /// After a stop, the frames in hand get this long, seconds (a frame takes well under one; a
+  /// sanitizer build's several). A stage still busy then (a source read or a fit that does not
+  /// return) is left behind: `inhandscan` exports the model so far without those frames, says
+  /// what it saved and exits with code 5 (Pipeline::Abandon).
+  double stop_grace_s = 20;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

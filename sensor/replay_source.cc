@@ -85,6 +85,10 @@ SourceRead ReplaySource::Next(std::chrono::milliseconds timeout) {
     SourceRead read = ReadUnderlying(remaining);
     if (read.status != SourceStatus::kFrame) return read;
     const std::int64_t index = next_index_++;
+    if (auto gate = faults_.blocked.find(index); gate != faults_.blocked.end() && gate->second) {
+      while (!gate->second->WaitUntil(std::chrono::steady_clock::now() + std::chrono::hours(1))) {
+      }
+    }
 
     Frame frame = *read.frame;
     const bool dropped = faults_.drop.count(index) > 0;

@@ -43,6 +43,9 @@ struct FaultPlan {
   /// Frames delivered only once their gate is open (Next() meanwhile times out as a stalled
   /// sensor does, so a stop is still noticed).
   std::map<std::int64_t, std::shared_ptr<FrameGate>> held;
+  /// Reads that do not return until their gate opens, whatever the timeout (a device read
+  /// stuck in its driver): the frame's read blocks.
+  std::map<std::int64_t, std::shared_ptr<FrameGate>> blocked;
   /// After this many frames have been read from the underlying stream, report kDisconnected.
   std::optional<std::int64_t> disconnect_after;
   /// Frames delivered with a depth image of the wrong size (fails Frame::Check).

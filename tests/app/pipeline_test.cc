@@ -225,6 +225,32 @@ TEST_F(PipelineFaultTest, StopFinishesTheFramesInHandAndExports) {
   EXPECT_EQ(Stats(out.path())["summary"]["end_reason"], "stopped");
 }
 
+// A source whose read never returns (a driver stuck in the kernel): the stop cannot finish the
+// frame in hand. Abandoned, the fusion thread exports the model so far at once, while the stuck
+// thread still runs.
+TEST_F(PipelineFaultTest, AStopThatCannotFinishItsFrameStillSavesTheModel) {
+  test::TempDir out;
+  sensor::FaultPlan faults;
+  const auto gate = std::make_shared<sensor::FrameGate>();
+  faults.blocked[10] = gate;
+  Pipeline pipeline(Faulty(faults), Options(), Into(out.path()));
+  pipeline.Start();
+  ASSERT_TRUE(WaitFor([&] { return pipeline.Progress().processed >= 10; }));
+  pipeline.RequestStop();
+  EXPECT_FALSE(pipeline.WaitForFinalExport(std::chrono::milliseconds(200)));  // Stuck.
+  pipeline.Abandon();
+  ASSERT_TRUE(pipeline.WaitForFinalExport(std::chrono::minutes(5)));
+  EXPECT_FALSE(pipeline.Wait(std::chrono::milliseconds(0)));  // The read still blocks.
+  EXPECT_TRUE(ReadMesh(out / "mesh.ply").IsWatertight());
+  const nlohmann::json stats = Stats(out.path());
+  EXPECT_EQ(stats["summary"]["final"], true);
+  EXPECT_EQ(stats["summary"]["frames"], 10);
+  EXPECT_EQ(stats["summary"]["end_reason"], "stopped, frames in hand left behind");
+  gate->Open();  // The read returns; every thread ends.
+  const PipelineResult result = pipeline.Finish();
+  EXPECT_EQ(result.progress.processed, 10);
+}
+
 TEST_F(PipelineFaultTest, MalformedAndEmptyFramesAreSkippedWithTheirReasons) {
   test::TempDir out;
   sensor::FaultPlan faults;
