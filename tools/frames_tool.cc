@@ -1,14 +1,17 @@
 // inhandscan-frames: what is in a recording (.oni or TUM folder), and conversion between the two.
 
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "core/command_line.h"
+#include "core/errors.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "sensor/oni_writer.h"
@@ -18,6 +21,7 @@
 
 namespace {
 
+namespace fs = std::filesystem;
 using ihs::sensor::FrameSource;
 using ihs::sensor::SourceRead;
 using ihs::sensor::SourceStatus;
@@ -76,23 +80,60 @@ int Info(const std::string& input, const ihs::sensor::InputOptions& options, boo
   return ihs::kExitOk;
 }
 
+// Where a conversion is written before it is complete: beside OUTPUT, hidden, removed unless
+// it is renamed into place (a full disk or a bad input leaves nothing under OUTPUT's name).
+class PartialOutput {
+ public:
+  explicit PartialOutput(const fs::path& output)
+      : final_(output.lexically_normal()),
+        partial_(final_.parent_path() /
+                 ("." + final_.filename().string() + ".partial-" + std::to_string(getpid()))) {
+    if (final_.filename().empty()) throw std::invalid_argument(output.string() + ": not a path");
+    std::error_code error;
+    if (fs::is_directory(final_, error) && !fs::is_empty(final_, error)) {
+      throw ihs::OutputError(final_.string() + ": a folder that is not empty; give a new one");
+    }
+  }
+  ~PartialOutput() {
+    std::error_code error;
+    if (!committed_) fs::remove_all(partial_, error);
+  }
+  const fs::path& path() const { return partial_; }
+  // Moves the complete output into place: replaces a file, or fills an absent or empty folder.
+  void Commit() {
+    std::error_code error;
+    if (fs::is_directory(final_, error)) fs::remove(final_, error);  // Empty (checked above).
+    fs::rename(partial_, final_, error);
+    if (error) {
+      throw ihs::OutputError(final_.string() + ": cannot move the conversion into place (" +
+                             error.message() + ")");
+    }
+    committed_ = true;
+  }
+
+ private:
+  const fs::path final_, partial_;
+  bool committed_ = false;
+};
+
 int Convert(const std::string& input, const std::string& output,
             const ihs::sensor::InputOptions& options) {
   auto source = ihs::sensor::OpenInput(input, options);
   source->Start();
   std::int64_t frames = 0;
   SourceRead end;
+  PartialOutput partial(output);
   if (ihs::sensor::OpenNiSource::IsOniPath(output)) {
     ihs::sensor::OniWriterOptions writer_options;
     writer_options.intrinsics = source->Intrinsics();
-    ihs::sensor::OniWriter writer(output, writer_options);
+    ihs::sensor::OniWriter writer(partial.path(), writer_options);
     end = Drain(*source, [&](const ihs::Frame& frame) {
       writer.Write(frame);
       ++frames;
     });
     writer.Close();
   } else {
-    ihs::sensor::TumWriter writer(output, source->Intrinsics(), options.tum);
+    ihs::sensor::TumWriter writer(partial.path(), source->Intrinsics(), options.tum);
     end = Drain(*source, [&](const ihs::Frame& frame) {
       writer.Write(frame);
       ++frames;
@@ -103,8 +144,10 @@ int Convert(const std::string& input, const std::string& output,
     spdlog::warn("{}: damaged recording: converted the {} frames that could be recovered", input,
                  frames);
   }
+  if (frames == 0) return ihs::kExitInput;
+  partial.Commit();
   spdlog::info("wrote {} frames to {}", frames, output);
-  return frames > 0 ? ihs::kExitOk : ihs::kExitInput;
+  return ihs::kExitOk;
 }
 
 }  // namespace

@@ -58,6 +58,51 @@ TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
   }
 }
 
+// A conversion is written aside and moved into place whole: a failed one leaves nothing under
+// the output's name (nor beside it), a folder that holds other files is not written into, and an
+// existing .oni is replaced only by a complete one.
+TEST(FramesToolTest, ConversionsAppearWholeOrNotAtAll) {
+  test::TempDir dir;
+  const auto frames = test::MakePatternFrames(3, 160, 120);
+  sensor::OniWriterOptions options;
+  options.intrinsics = CameraIntrinsics::Carmine109().Scaled(160, 120);
+  {
+    sensor::OniWriter writer(dir / "a.oni", options);
+    for (const Frame& frame : frames) writer.Write(frame);
+    writer.Close();
+  }
+  test::WriteBytes(dir / "junk.oni", "junk");
+  test::WriteBytes(dir / "b.oni", "an older file");
+  EXPECT_EQ(RunTool("-q convert " + (dir / "junk.oni").string() + " " + (dir / "b.oni").string())
+                .exit_code,
+            3);
+  EXPECT_EQ(test::ReadFileString(dir / "b.oni"), "an older file");
+  std::filesystem::create_directories(dir / "taken");
+  test::WriteBytes(dir / "taken" / "notes.txt", "mine");
+  const auto taken =
+      RunTool("-q convert " + (dir / "a.oni").string() + " " + (dir / "taken").string());
+  EXPECT_EQ(taken.exit_code, 6) << taken.err;
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir / "taken"), {}), 1);
+  ASSERT_EQ(
+      RunTool("-q convert " + (dir / "a.oni").string() + " " + (dir / "b.oni").string()).exit_code,
+      0);
+  sensor::OniFileSource converted(dir / "b.oni");
+  converted.Start();
+  EXPECT_EQ(converted.FrameCount(), 3);
+  // A folder whose every image is unreadable: the writer has begun, no frame comes; the partial
+  // output goes.
+  ASSERT_EQ(
+      RunTool("-q convert " + (dir / "a.oni").string() + " " + (dir / "tum").string()).exit_code,
+      0);
+  for (const auto& entry : sensor::ListTumDirectory(dir / "tum", sensor::TumOptions{}))
+    test::WriteBytes(dir / "tum" / entry.depth_path, "not a png");
+  EXPECT_EQ(
+      RunTool("-q convert " + (dir / "tum").string() + " " + (dir / "c.oni").string()).exit_code,
+      3);
+  // Nothing else beside the inputs and outputs: a.oni, junk.oni, b.oni, taken/, tum/.
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 5);
+}
+
 TEST(FramesToolTest, DamagedRecordingConvertsWhatCanBeRecoveredAndSaysSo) {
   const std::filesystem::path kinect = test::KinectRecording();
   if (kinect.empty()) GTEST_SKIP() << "../shared/data is absent";
