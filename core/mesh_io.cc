@@ -358,6 +358,15 @@ TriangleMesh DecodePly(const std::string& bytes, const std::string& name) {
     if (element.count > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max())) {
       Fail(name, "PLY element " + element.name + " has too many entries");
     }
+    // Entries without properties occupy no bytes, so the size check above cannot bound them:
+    // a vertex or face needs properties, any other such element is skipped without counting
+    // through its entries (a 200-byte header declaring 2e9 of them took minutes).
+    if (element.properties.empty()) {
+      if (element.count > 0 && (element.name == "vertex" || element.name == "face"))
+        Fail(name, "PLY element " + element.name + " has entries but no properties");
+      if (element.name == "vertex") have_vertices = true;
+      continue;
+    }
 
     if (element.name == "vertex") {
       have_vertices = true;
