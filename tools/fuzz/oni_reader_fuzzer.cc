@@ -1,6 +1,6 @@
 // libFuzzer target for the .oni reader: indexes arbitrary bytes and decodes every frame found.
-// Build with clang: cmake -DCMAKE_CXX_COMPILER=clang++ -DIHS_FUZZ=ON, then run
-// build/tools/fuzz/oni_reader_fuzzer -max_total_time=60 (optionally with a corpus folder).
+// Built and run by tools/fuzz.sh (clang, -DIHS_FUZZ=ON, in build-fuzz):
+// tools/fuzz.sh 60 oni_reader_fuzzer, or build-fuzz/tools/fuzz/oni_reader_fuzzer CORPUS.
 
 #include <cstddef>
 #include <cstdint>
