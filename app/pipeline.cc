@@ -429,6 +429,12 @@ void Pipeline::ExportLoop() {
                                 {"volume_mm3", exported.meshes.watertight.IsWatertight()
                                                    ? exported.meshes.watertight.Volume()
                                                    : 0.0}}}};
+      if (final && !s.live) {
+        // Frames of a recording its reader could not decode (skipped, each said in the log):
+        // read once the capture has ended (the final job comes after it through the queues).
+        extra["dropped_frames"]["unreadable_in_input"] = source_->SkippedFrames();
+        extra["input_recovered"] = source_->Recovered();
+      }
       {
         std::lock_guard<std::mutex> lock(s.mutex);
         if (!s.end_reason.empty()) extra["end_reason"] = s.end_reason;

@@ -78,8 +78,15 @@ cv::Mat ReadImage(const fs::path& path, int flags, std::string* problem) {
                std::to_string(height) + " pixels, more than a depth camera's frame can have";
     return {};
   }
-  cv::Mat image =
-      cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), flags);
+  cv::Mat image;
+  if (!bytes.empty()) {
+    try {
+      image =
+          cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), flags);
+    } catch (const cv::Exception&) {
+      image.release();  // A decoder that throws on damaged data: the frame is skipped.
+    }
+  }
   if (image.empty()) *problem = "cannot decode " + path.filename().string();
   return image;
 }

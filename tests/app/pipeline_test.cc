@@ -17,6 +17,7 @@
 #include "fusion/measure.h"
 #include "sensor/open_input.h"
 #include "sensor/replay_source.h"
+#include "sensor/tum_directory.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
 
@@ -148,6 +149,25 @@ TEST_F(PipelineTest, ReplayScansTheSphereToItsSize) {
     ++previews;
   }
   EXPECT_GE(previews, 2);  // Every 30 fused frames.
+}
+
+// A frame of a recording that cannot be decoded is skipped, and stats.json counts it.
+TEST_F(PipelineTest, FramesTheInputCannotDecodeAreCountedInTheStats) {
+  test::TempDir copy, out;
+  fs::copy(Tum(), copy / "tum", fs::copy_options::recursive);
+  const auto entries = sensor::ListTumDirectory(copy / "tum", sensor::TumOptions{});
+  test::WriteBytes(copy / "tum" / entries[3].depth_path, "not a png");
+  test::WriteBytes(copy / "tum" / entries[5].depth_path, "");
+  ScannerOptions options;
+  options.scan.hand_scale = 1.0;  // The generator's hand: no scale estimate over the first frames.
+  options.pipeline.max_frames = 12;
+  options.pipeline.preview_every = 0;
+  const PipelineResult result = Run(Open(copy / "tum"), out.path(), options);
+  ASSERT_EQ(result.exit_code, kExitOk) << result.error;
+  const nlohmann::json stats = Stats(out.path());
+  EXPECT_EQ(stats["summary"]["dropped_frames"]["unreadable_in_input"], 2);
+  EXPECT_EQ(stats["summary"]["input_recovered"], false);
+  EXPECT_EQ(stats["frames"].size(), 12u);
 }
 
 TEST_F(PipelineTest, ReplaysAreDeterministicAndATumFolderScansLikeItsOniFile) {

@@ -84,13 +84,14 @@ TEST(TumDirectoryTest, MatchesByNearestTimestampWithoutAssociations) {
 
 TEST(TumDirectoryTest, UnreadableImagesAreSkippedAndCounted) {
   test::TempDir dir;
-  WriteFrames(dir.path(), test::MakePatternFrames(3, 16, 12), CameraIntrinsics{}.Scaled(16, 12));
+  WriteFrames(dir.path(), test::MakePatternFrames(4, 16, 12), CameraIntrinsics{}.Scaled(16, 12));
   const auto entries = ListTumDirectory(dir.path(), TumOptions{});
   test::WriteBytes(dir / entries[1].depth_path, "not a png");
+  test::WriteBytes(dir / entries[2].color_path, "");  // An empty file (imdecode throws on none).
   TumDirectorySource source(dir.path());
   const auto frames = test::ReadAllFrames(source);
   ASSERT_EQ(frames.size(), 2u);
-  EXPECT_EQ(source.SkippedFrames(), 1);
+  EXPECT_EQ(source.SkippedFrames(), 2);
   EXPECT_EQ(frames[1]->index, 1);  // Indices count delivered frames.
 }
 
