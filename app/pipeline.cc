@@ -156,13 +156,10 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
     throw OutputError(output_.folder.string() + ": cannot create the output folder" +
                       (error ? " (" + error.message() + ")" : ""));
   }
-  if (const int removed = RemovePreviousScan(output_.folder)) {
-    spdlog::info("{}: removed {} files of an earlier scan", output_.folder.string(), removed);
-  }
+  source_->Start();
   if (options_.pipeline.preview_every > 0) {
     std::filesystem::create_directories(output_.folder / "preview", error);
   }
-  source_->Start();
   shared_ = std::make_unique<Shared>(options_.pipeline.queue_capacity, source_->IsLive());
   shared_->intrinsics = source_->Intrinsics();
   shared_->hand = std::make_unique<HandStage>(options_, shared_->intrinsics);
@@ -172,6 +169,11 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
     shared_->joint_parents.push_back(bone.parent < 0 ? 0 : bone.parent + 1);
   }
   if (initial_hand_pose) shared_->hand->Initialise(*initial_hand_pose);
+  // Only once the input opened and the stages were made: a mistyped input or template must not
+  // cost the earlier scan.
+  if (const int removed = RemovePreviousScan(output_.folder)) {
+    spdlog::info("{}: removed {} files of an earlier scan", output_.folder.string(), removed);
+  }
   shared_->start = SteadyClock::now();
   started_ = true;
   shared_->running = 4;

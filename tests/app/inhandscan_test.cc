@@ -119,6 +119,11 @@ TEST(InhandscanTest, RecordingsWithoutAHandScanNothingAndSaySo) {
   fs::create_directories(dir / "ball" / "preview");
   for (const char* name : {"mesh.ply", "stats.json", "preview/000030.png", "notes.txt"})
     test::WriteBytes(dir / "ball" / name, "from an earlier scan");
+  // A mistyped input does not cost the earlier scan.
+  const auto missing =
+      RunApp("replay " + (dir / "bal.oni").string() + " --out " + (dir / "ball").string() + " -q");
+  EXPECT_EQ(missing.exit_code, 3) << missing.err;
+  EXPECT_EQ(test::ReadFileString(dir / "ball" / "mesh.ply"), "from an earlier scan");
   ExpectNothingScannedForWantOfAHand(dir / "ball.oni", dir / "ball");
   EXPECT_FALSE(fs::exists(dir / "ball" / "preview" / "000030.png"));
   EXPECT_NE(test::ReadFileString(dir / "ball" / "stats.json"), "from an earlier scan");
