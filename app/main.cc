@@ -161,9 +161,7 @@ class StopGuard {
     // frame never gets to it.
     const bool exported = pipeline_.WaitForFinalExport(std::chrono::milliseconds(0));
     if (!exported && now - *abandoned_at_ <= grace_ + kExportWait) return;
-    std::string saved;
-    for (const fs::path& file : ihs::app::ScanFilesIn(folder_))
-      saved += (saved.empty() ? "" : ", ") + file.filename().string();
+    const std::string saved = ihs::app::ScanFileNamesIn(folder_);
     std::fprintf(stderr, "inhandscan: error: %s\n",
                  ihs::OneLine("a stage did not finish its frame after the stop; " +
                               (saved.empty() ? std::string("nothing could be saved")

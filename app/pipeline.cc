@@ -538,9 +538,7 @@ PipelineResult Pipeline::Finish() {
     result.error = s.failed_stage + ": " + MessageOf(s.failure);
     // What is in the folder now was written by this scan (an earlier one's files were removed
     // when it started), the final export's or an earlier export's.
-    std::string saved;
-    for (const std::filesystem::path& file : ScanFilesIn(output_.folder))
-      saved += (saved.empty() ? "" : ", ") + file.filename().string();
+    const std::string saved = ScanFileNamesIn(output_.folder);
     if (saved.empty()) {
       result.error += " (nothing could be saved)";
     } else if (std::filesystem::exists(output_.folder / "mesh.ply")) {

@@ -48,6 +48,13 @@ std::vector<std::filesystem::path> ScanFilesIn(const std::filesystem::path& fold
   return found;
 }
 
+std::string ScanFileNamesIn(const std::filesystem::path& folder) {
+  std::string names;
+  for (const std::filesystem::path& file : ScanFilesIn(folder))
+    names += (names.empty() ? "" : ", ") + file.filename().string();
+  return names;
+}
+
 int RemovePreviousScan(const std::filesystem::path& folder) {
   namespace fs = std::filesystem;
   std::vector<fs::path> stale = ScanFilesIn(folder);

@@ -35,6 +35,8 @@ ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
 /// The files a scan writes that are in `folder` now (see RemovePreviousScan for the names;
 /// previews not included), in that order.
 std::vector<std::filesystem::path> ScanFilesIn(const std::filesystem::path& folder);
+/// Their names as one line ("mesh.ply, mesh_tsdf.ply, …"); empty when there are none.
+std::string ScanFileNamesIn(const std::filesystem::path& folder);
 
 /// Removes from `folder` the files an earlier scan wrote there (mesh.ply, mesh_tsdf.ply,
 /// mesh.obj, mesh.stl, trajectory.txt, hand_joints.csv, hand_poses.csv, stats.json and the PNGs

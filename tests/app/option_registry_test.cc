@@ -185,11 +185,7 @@ TEST(OptionRegistryTest, ValuesThatWouldExhaustMemoryOrTimeAreRefused) {
   for (const auto& [name, value] : cases) {
     ScannerOptions options;
     OptionRegistry registry = RegisterScannerOptions(&options);
-    try {
-      registry.Set(name, value);
-    } catch (const std::invalid_argument&) {
-      continue;  // Not even of the field's type ("1e9" for an int): refused already.
-    }
+    registry.Set(name, value);  // Of the field's type: only Check() can refuse it.
     const std::string field = name.substr(name.rfind('.') + 1);
     try {
       options.Check();

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "sensor/oni_reader.h"
 #include "sensor/oni_writer.h"
@@ -20,15 +22,19 @@ test::CommandResult RunTool(const std::string& arguments) {
   return test::RunCommand(std::string(IHS_FRAMES_TOOL) + " " + arguments);
 }
 
+// Writes `frames` (160 x 120) as an .oni recording with our writer.
+void WriteOni(const std::filesystem::path& path, const std::vector<Frame>& frames) {
+  sensor::OniWriterOptions options;
+  options.intrinsics = CameraIntrinsics::Carmine109().Scaled(160, 120);
+  sensor::OniWriter writer(path, options);
+  for (const Frame& frame : frames) writer.Write(frame);
+  writer.Close();
+}
+
 TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
   test::TempDir dir;
   const auto frames = test::MakePatternFrames(4, 160, 120);
-  {
-    sensor::OniWriterOptions options;
-    options.intrinsics = CameraIntrinsics::Carmine109().Scaled(160, 120);
-    sensor::OniWriter writer(dir / "a.oni", options);
-    for (const Frame& frame : frames) writer.Write(frame);
-  }
+  WriteOni(dir / "a.oni", frames);
   const test::CommandResult info = RunTool("info --json " + (dir / "a.oni").string());
   ASSERT_EQ(info.exit_code, 0) << info.err;
   const auto json = nlohmann::json::parse(info.out);
@@ -63,14 +69,7 @@ TEST(FramesToolTest, InfoJsonDescribesOurRecordingAndConvertRoundTrips) {
 // existing .oni is replaced only by a complete one.
 TEST(FramesToolTest, ConversionsAppearWholeOrNotAtAll) {
   test::TempDir dir;
-  const auto frames = test::MakePatternFrames(3, 160, 120);
-  sensor::OniWriterOptions options;
-  options.intrinsics = CameraIntrinsics::Carmine109().Scaled(160, 120);
-  {
-    sensor::OniWriter writer(dir / "a.oni", options);
-    for (const Frame& frame : frames) writer.Write(frame);
-    writer.Close();
-  }
+  WriteOni(dir / "a.oni", test::MakePatternFrames(3, 160, 120));
   test::WriteBytes(dir / "junk.oni", "junk");
   test::WriteBytes(dir / "b.oni", "an older file");
   EXPECT_EQ(RunTool("-q convert " + (dir / "junk.oni").string() + " " + (dir / "b.oni").string())
