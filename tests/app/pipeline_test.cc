@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "app/scan_stages.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
 #include "core/mesh_io.h"
@@ -20,6 +21,8 @@
 #include "sensor/tum_directory.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
+#include "tracker/hand_fit.h"
+#include "tracker/hand_joints_io.h"
 
 namespace ihs::app {
 namespace {
@@ -63,11 +66,12 @@ class PipelineTestBase : public ::testing::Test {
     return output;
   }
 
-  // Runs a pipeline to its end.
+  // Runs a pipeline to its end, the hand searched for or started at `hand`.
   static PipelineResult Run(std::unique_ptr<sensor::FrameSource> source, const fs::path& out,
-                            ScannerOptions options = {}) {
+                            ScannerOptions options = {},
+                            const std::optional<tracker::HandPose>& hand = std::nullopt) {
     Pipeline pipeline(std::move(source), options, Into(out));
-    pipeline.Start();
+    pipeline.Start(hand);
     return pipeline.Finish();
   }
 
@@ -101,12 +105,36 @@ class PipelineFaultTest : public PipelineTestBase {
   static fs::path Oni() { return Sequences::Get(30, false) / "sequence.oni"; }
 
   // The generator's hand is the template at its own size: no scale estimate (which fits every
-  // candidate scale on the first frames) to keep these runs short.
+  // candidate scale on the first frames) to keep these runs short. A coarser volume (2.7 mm
+  // voxels) and Poisson octree: these runs check the threads' paths, not the model's accuracy,
+  // and every one of them exports.
   static ScannerOptions Options() {
     ScannerOptions options;
     options.scan.hand_scale = 1.0;
+    options.fusion.tsdf.resolution = 128;
+    options.meshing.poisson_depth = 8;
     options.pipeline.preview_every = 0;
     return options;
+  }
+
+  // The generator's first hand pose. These runs start the tracker there: the search for a hand
+  // that is not yet tracked was half of a short run's time under ThreadSanitizer, and the
+  // self-initialised scan is PipelineTest's.
+  static const tracker::HandPose& FirstHand() {
+    static const tracker::HandPose pose = [] {
+      auto source = Open(Oni());
+      source->Start();
+      const HandStage stage(Options(), source->Intrinsics());
+      const auto joints =
+          tracker::ReadHandJointsCsv(Oni().parent_path() / "gt" / "hand_joints.csv");
+      return tracker::FitPoseToJoints(stage.model(), joints.at(0).joints_mm);
+    }();
+    return pose;
+  }
+
+  static PipelineResult Run(std::unique_ptr<sensor::FrameSource> source, const fs::path& out,
+                            const ScannerOptions& options) {
+    return PipelineTestBase::Run(std::move(source), out, options, FirstHand());
   }
 
   static std::unique_ptr<sensor::FrameSource> Faulty(sensor::FaultPlan faults) {
@@ -192,7 +220,7 @@ TEST_F(PipelineFaultTest, AnExportOnRequestWritesAValidMeshAndTheScanGoesOn) {
   ScannerOptions options = Options();
   options.pipeline.max_frames = 25;
   Pipeline pipeline(Faulty(faults), options, Into(out.path()));
-  pipeline.Start();
+  pipeline.Start(FirstHand());
   ASSERT_TRUE(WaitFor([&] { return pipeline.Progress().processed >= 15; }));
   pipeline.RequestExport();
   ASSERT_TRUE(WaitFor([&] { return pipeline.Progress().exports >= 1; }));
@@ -234,7 +262,7 @@ TEST_F(PipelineFaultTest, StopFinishesTheFramesInHandAndExports) {
   faults.held[10] = std::make_shared<sensor::FrameGate>();
   ScannerOptions options = Options();
   Pipeline pipeline(Faulty(faults), options, Into(out.path()));
-  pipeline.Start();
+  pipeline.Start(FirstHand());
   ASSERT_TRUE(WaitFor([&] { return pipeline.Progress().processed >= 10; }));
   pipeline.RequestStop();
   const PipelineResult result = pipeline.Finish();
@@ -254,7 +282,7 @@ TEST_F(PipelineFaultTest, AStopThatCannotFinishItsFrameStillSavesTheModel) {
   const auto gate = std::make_shared<sensor::FrameGate>();
   faults.blocked[10] = gate;
   Pipeline pipeline(Faulty(faults), Options(), Into(out.path()));
-  pipeline.Start();
+  pipeline.Start(FirstHand());
   ASSERT_TRUE(WaitFor([&] { return pipeline.Progress().processed >= 10; }));
   pipeline.RequestStop();
   EXPECT_FALSE(pipeline.WaitForFinalExport(std::chrono::milliseconds(200)));  // Stuck.
