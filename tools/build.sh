@@ -14,6 +14,9 @@ build_dir="${IHS_BUILD_DIR:-build}"
 build_type="${IHS_BUILD_TYPE:-Release}"
 sanitize="${IHS_SANITIZE:-}"
 jobs="${IHS_JOBS:-$(nproc)}"
+# Paths under the checkout are hashed relative to it: another clone's build (CI's) reuses this
+# one's compiled objects.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$root}"
 
 generator=()
 if [[ ! -f "$build_dir/CMakeCache.txt" ]] && command -v ninja >/dev/null 2>&1; then
