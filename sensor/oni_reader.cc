@@ -2,7 +2,6 @@
 
 #include <fcntl.h>
 #include <spdlog/spdlog.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -26,6 +25,9 @@ constexpr std::size_t kFileHeaderSize = 24;
 // No real frame is larger than this (1600·1200·3 is OpenNI's own limit); it bounds allocations.
 constexpr std::size_t kMaxFrameBytes = 64u << 20;
 constexpr int kMaxImageSide = 8192;
+// A record's fields are a name and a few numbers, or a property's value (the largest real ones,
+// depth-to-colour tables, are tens of kB); it bounds what indexing reads at once.
+constexpr std::size_t kMaxFieldsBytes = 16u << 20;
 
 enum RecordType : std::uint32_t {
   kNodeAdded_1_0_0_4 = 2,
@@ -92,6 +94,44 @@ class FieldReader {
   std::size_t position_ = 0;
 };
 
+// Byte ranges of a recording: all of it in memory, or a file read a piece at a time.
+class OniBytes {
+ public:
+  virtual ~OniBytes() = default;
+  virtual std::uint64_t Size() const = 0;
+  // The `count` bytes at `offset` (offset + count <= Size()), valid until the next Read.
+  virtual std::string_view Read(std::uint64_t offset, std::size_t count) = 0;
+};
+
+class MemoryBytes final : public OniBytes {
+ public:
+  explicit MemoryBytes(std::string_view bytes) : bytes_(bytes) {}
+  std::uint64_t Size() const override { return bytes_.size(); }
+  std::string_view Read(std::uint64_t offset, std::size_t count) override {
+    return bytes_.substr(static_cast<std::size_t>(offset), count);
+  }
+
+ private:
+  std::string_view bytes_;
+};
+
+// The record types whose fields the index reads.
+bool ReadsFields(std::uint32_t type) {
+  switch (type) {
+    case kNodeAdded:
+    case kNodeAdded_1_0_0_5:
+    case kNodeAdded_1_0_0_4:
+    case kIntProperty:
+    case kRealProperty:
+    case kStringProperty:
+    case kGeneralProperty:
+    case kNewData:
+      return true;
+    default:
+      return false;
+  }
+}
+
 OniNode* FindNode(std::vector<OniNode>& nodes, std::uint32_t id) {
   for (OniNode& node : nodes) {
     if (node.id == id) return &node;
@@ -136,123 +176,161 @@ const OniNode* OniIndex::FirstOfType(OniNodeType type) const {
   return nullptr;
 }
 
-OniIndex IndexOni(std::string_view bytes, const std::string& name) {
-  if (bytes.size() < kFileHeaderSize || std::memcmp(bytes.data(), "NI10", 4) != 0) {
+namespace {
+
+// Checks the file header and fills the index's version; returns the size of a record header
+// (24 bytes up to version 1.0.0.5, 28 from 1.0.1.0).
+std::size_t ReadFileHeader(OniBytes& bytes, const std::string& name, OniIndex& index) {
+  const std::string_view header =
+      bytes.Size() < kFileHeaderSize ? std::string_view() : bytes.Read(0, kFileHeaderSize);
+  if (header.size() < kFileHeaderSize || std::memcmp(header.data(), "NI10", 4) != 0) {
     throw InputError(name + ": not an .oni recording (no NI10 header)");
   }
-  const auto major = static_cast<std::uint8_t>(bytes[4]);
-  const auto minor = static_cast<std::uint8_t>(bytes[5]);
-  const auto maintenance = Load<std::uint16_t>(bytes.data() + 6);
-  const auto build = Load<std::uint32_t>(bytes.data() + 8);
-  OniIndex index;
+  const auto major = static_cast<std::uint8_t>(header[4]);
+  const auto minor = static_cast<std::uint8_t>(header[5]);
+  const auto maintenance = Load<std::uint16_t>(header.data() + 6);
+  const auto build = Load<std::uint32_t>(header.data() + 8);
   index.version = std::to_string(major) + "." + std::to_string(minor) + "." +
                   std::to_string(maintenance) + "." + std::to_string(build);
   const auto version = std::make_tuple(major, minor, maintenance, build);
   if (version < std::make_tuple(1, 0, 0, 4) || version > std::make_tuple(1, 0, 1, 0)) {
     throw InputError(name + ": unsupported .oni version " + index.version);
   }
-  const bool wide = version >= std::make_tuple(1, 0, 1, 0);
-  const std::size_t header_size = wide ? 28 : 24;
+  return version >= std::make_tuple(1, 0, 1, 0) ? 28 : 24;
+}
 
-  std::size_t position = kFileHeaderSize;
+// One record's header.
+struct RecordHeader {
+  std::uint32_t magic = 0;
+  std::uint32_t type = 0;
+  std::uint32_t node_id = 0;
+  std::uint32_t fields_size = 0;
+  std::uint32_t payload_size = 0;
+};
+
+// Adds what one record says to the index (its fields in `fields`, its payload at
+// `payload_offset`). Returns false for a record type the reader does not know.
+bool ApplyRecord(const RecordHeader& record, FieldReader& fields, std::uint64_t payload_offset,
+                 OniIndex& index) {
+  switch (record.type) {
+    case kNodeAdded:
+    case kNodeAdded_1_0_0_5:
+    case kNodeAdded_1_0_0_4: {
+      OniNode node;
+      node.id = record.node_id;
+      node.name = fields.String();
+      node.type = fields.Get<std::int32_t>();
+      node.codec = fields.Get<std::uint32_t>();
+      if (record.type != kNodeAdded_1_0_0_4) node.declared_frames = fields.Get<std::uint32_t>();
+      if (node.type == static_cast<std::int32_t>(OniNodeType::kDepth)) node.pixel_format = 100;
+      if (node.type == static_cast<std::int32_t>(OniNodeType::kImage)) node.pixel_format = 200;
+      if (node.type == static_cast<std::int32_t>(OniNodeType::kIr)) node.pixel_format = 203;
+      if (fields.ok) {
+        if (OniNode* existing = FindNode(index.nodes, record.node_id)) {
+          // OpenNI rewrites NODE_ADDED at close; a repeated one (after looping) keeps the frames.
+          node.frames = std::move(existing->frames);
+          *existing = std::move(node);
+        } else {
+          index.nodes.push_back(std::move(node));
+        }
+      }
+      return true;
+    }
+    case kIntProperty:
+    case kRealProperty:
+    case kStringProperty:
+    case kGeneralProperty: {
+      const std::string property = fields.String();
+      const std::uint32_t value_size = fields.Get<std::uint32_t>();
+      const std::string_view value = fields.Bytes(value_size);
+      if (OniNode* node = FindNode(index.nodes, record.node_id); node && fields.ok) {
+        ApplyProperty(*node, record.type, property, value);
+      }
+      return true;
+    }
+    case kNewData: {
+      OniFrameRecord frame;
+      frame.timestamp_us = fields.Get<std::uint64_t>();
+      frame.frame_number = fields.Get<std::uint32_t>();
+      frame.payload_offset = payload_offset;
+      frame.payload_size = record.payload_size;
+      OniNode* node = FindNode(index.nodes, record.node_id);
+      if (fields.ok && node) node->frames.push_back(frame);
+      return true;
+    }
+    case kNodeRemoved:
+    case kNodeDataBegin:
+    case kNodeStateReady:
+    case kSeekTable:
+      return true;
+    case kEnd:
+      index.complete = true;
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Indexes the records of `bytes`, reading each record's header and, where they matter, its
+// fields; payloads are only stepped over.
+OniIndex IndexRecords(OniBytes& bytes, const std::string& name) {
+  OniIndex index;
+  const std::size_t header_size = ReadFileHeader(bytes, name, index);
+  const std::uint64_t size = bytes.Size();
+  std::uint64_t position = kFileHeaderSize;
   auto stop = [&](const std::string& why) {
     index.damage = why + " at byte " + std::to_string(position);
   };
-  while (true) {
-    if (position == bytes.size()) {
+  while (!index.complete) {
+    if (position == size) {
       stop("the file ends without an END record");
       break;
     }
-    if (bytes.size() - position < header_size) {
+    if (size - position < header_size) {
       stop("the file ends inside a record header");
       break;
     }
-    const char* record = bytes.data() + position;
-    const auto magic = Load<std::uint32_t>(record);
-    const auto type = Load<std::uint32_t>(record + 4);
-    const auto node_id = Load<std::uint32_t>(record + 8);
-    const auto fields_size = Load<std::uint32_t>(record + 12);
-    const auto payload_size = Load<std::uint32_t>(record + 16);
-    if (magic != kRecordMagic || fields_size < header_size) {
+    const char* data = bytes.Read(position, header_size).data();
+    const RecordHeader record{Load<std::uint32_t>(data), Load<std::uint32_t>(data + 4),
+                              Load<std::uint32_t>(data + 8), Load<std::uint32_t>(data + 12),
+                              Load<std::uint32_t>(data + 16)};
+    if (record.magic != kRecordMagic || record.fields_size < header_size) {
       stop("invalid record header");
       break;
     }
-    const std::size_t available = bytes.size() - position;
-    if (fields_size > available || payload_size > available - fields_size) {
+    const std::uint64_t available = size - position;
+    if (record.fields_size > available || record.payload_size > available - record.fields_size) {
       stop("the file ends inside a record");
       break;
     }
-    FieldReader fields(record + header_size, fields_size - header_size);
-    bool known = true;
-    switch (type) {
-      case kNodeAdded:
-      case kNodeAdded_1_0_0_5:
-      case kNodeAdded_1_0_0_4: {
-        OniNode node;
-        node.id = node_id;
-        node.name = fields.String();
-        node.type = fields.Get<std::int32_t>();
-        node.codec = fields.Get<std::uint32_t>();
-        if (type != kNodeAdded_1_0_0_4) node.declared_frames = fields.Get<std::uint32_t>();
-        if (node.type == static_cast<std::int32_t>(OniNodeType::kDepth)) node.pixel_format = 100;
-        if (node.type == static_cast<std::int32_t>(OniNodeType::kImage)) node.pixel_format = 200;
-        if (node.type == static_cast<std::int32_t>(OniNodeType::kIr)) node.pixel_format = 203;
-        if (fields.ok) {
-          if (OniNode* existing = FindNode(index.nodes, node_id)) {
-            // OpenNI rewrites NODE_ADDED at close; a repeated one (after looping) keeps the frames.
-            node.frames = std::move(existing->frames);
-            *existing = std::move(node);
-          } else {
-            index.nodes.push_back(std::move(node));
-          }
-        }
-        break;
-      }
-      case kIntProperty:
-      case kRealProperty:
-      case kStringProperty:
-      case kGeneralProperty: {
-        const std::string property = fields.String();
-        const std::uint32_t value_size = fields.Get<std::uint32_t>();
-        const std::string_view value = fields.Bytes(value_size);
-        if (OniNode* node = FindNode(index.nodes, node_id); node && fields.ok) {
-          ApplyProperty(*node, type, property, value);
-        }
-        break;
-      }
-      case kNewData: {
-        OniFrameRecord frame;
-        frame.timestamp_us = fields.Get<std::uint64_t>();
-        frame.frame_number = fields.Get<std::uint32_t>();
-        frame.payload_offset = position + fields_size;
-        frame.payload_size = payload_size;
-        OniNode* node = FindNode(index.nodes, node_id);
-        if (fields.ok && node) node->frames.push_back(frame);
-        break;
-      }
-      case kNodeRemoved:
-      case kNodeDataBegin:
-      case kNodeStateReady:
-      case kSeekTable:
-        break;
-      case kEnd:
-        index.complete = true;
-        break;
-      default:
-        known = false;
+    const std::size_t fields_bytes = record.fields_size - header_size;
+    if (ReadsFields(record.type) && fields_bytes > kMaxFieldsBytes) {
+      stop("a record of type " + std::to_string(record.type) + " with " +
+           std::to_string(fields_bytes) + " bytes of fields");
+      break;
     }
-    if (!known) {
-      stop("unknown record type " + std::to_string(type));
+    const std::string_view field_view = ReadsFields(record.type)
+                                            ? bytes.Read(position + header_size, fields_bytes)
+                                            : std::string_view();
+    FieldReader fields(field_view.data(), field_view.size());
+    if (!ApplyRecord(record, fields, position + record.fields_size, index)) {
+      stop("unknown record type " + std::to_string(record.type));
       break;
     }
     if (!fields.ok) {
-      stop("malformed record of type " + std::to_string(type));
+      stop("malformed record of type " + std::to_string(record.type));
       break;
     }
-    if (index.complete) break;
-    position += static_cast<std::size_t>(fields_size) + payload_size;
+    position += static_cast<std::uint64_t>(record.fields_size) + record.payload_size;
   }
   return index;
+}
+
+}  // namespace
+
+OniIndex IndexOni(std::string_view bytes, const std::string& name) {
+  MemoryBytes memory(bytes);
+  return IndexRecords(memory, name);
 }
 
 bool DecodeOniDepth(std::string_view bytes, const OniNode& node, const OniFrameRecord& record,
@@ -310,18 +388,61 @@ bool DecodeOniColor(std::string_view bytes, const OniNode& node, const OniFrameR
   return true;
 }
 
-// A read-only memory map of the file, so that large recordings are not copied into memory.
-struct OniFileSource::Mapping {
-  int fd = -1;
-  void* address = MAP_FAILED;
-  std::size_t size = 0;
-  std::string_view bytes() const {
-    return size ? std::string_view(static_cast<const char*>(address), size) : std::string_view();
+// The recording read a piece at a time, never mapped: memory stays bounded by one frame whatever
+// the file's size, and a file that shrinks while it plays is an input error (a mapping's read
+// past the new end is SIGBUS).
+class OniFileSource::File final : public OniBytes {
+ public:
+  explicit File(std::string name) : name_(std::move(name)) {
+    fd_ = ::open(name_.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) throw InputError(name_ + ": cannot open: " + std::strerror(errno));
+    struct stat status {};
+    if (fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) {
+      throw InputError(name_ + ": not a regular file");
+    }
+    size_ = static_cast<std::uint64_t>(status.st_size);
+    if (size_ == 0) throw InputError(name_ + ": the file is empty");
   }
-  ~Mapping() {
-    if (address != MAP_FAILED) munmap(address, size);
-    if (fd >= 0) close(fd);
+  ~File() override {
+    if (fd_ >= 0) ::close(fd_);
   }
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
+
+  std::uint64_t Size() const override { return size_; }
+  std::string_view Read(std::uint64_t offset, std::size_t count) override {
+    buffer_.resize(count);
+    std::size_t done = 0;
+    while (done < count) {
+      const ssize_t n =
+          ::pread(fd_, buffer_.data() + done, count - done, static_cast<off_t>(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw InputError(name_ + ": cannot read: " + std::strerror(errno));
+      if (n == 0) {
+        throw InputError(name_ + ": the file ends at byte " + std::to_string(offset + done) +
+                         " though it had " + std::to_string(size_) +
+                         " when the scan opened it: it was cut while it was read");
+      }
+      done += static_cast<std::size_t>(n);
+    }
+    return {buffer_.data(), count};
+  }
+
+  // A frame record's payload, and the record as it lies in that payload. False when it is too
+  // large to be a frame (DecodeOni* would refuse it).
+  bool Payload(const OniFrameRecord& record, std::string_view& bytes, OniFrameRecord& at) {
+    if (record.payload_size > kMaxFrameBytes) return false;
+    bytes = Read(record.payload_offset, record.payload_size);
+    at = record;
+    at.payload_offset = 0;
+    return true;
+  }
+
+ private:
+  const std::string name_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+  std::vector<char> buffer_;
 };
 
 OniFileSource::OniFileSource(std::filesystem::path path, std::int64_t max_color_offset_us)
@@ -333,20 +454,8 @@ OniFileSource::~OniFileSource() = default;
 
 void OniFileSource::Start() {
   const std::string name = path_.string();
-  auto mapping = std::make_unique<Mapping>();
-  mapping->fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC);
-  if (mapping->fd < 0) throw InputError(name + ": cannot open: " + std::strerror(errno));
-  struct stat status {};
-  if (fstat(mapping->fd, &status) != 0 || !S_ISREG(status.st_mode)) {
-    throw InputError(name + ": not a regular file");
-  }
-  mapping->size = static_cast<std::size_t>(status.st_size);
-  if (mapping->size == 0) throw InputError(name + ": the file is empty");
-  mapping->address = mmap(nullptr, mapping->size, PROT_READ, MAP_PRIVATE, mapping->fd, 0);
-  if (mapping->address == MAP_FAILED) {
-    throw InputError(name + ": cannot map: " + std::strerror(errno));
-  }
-  index_ = IndexOni(mapping->bytes(), name);
+  auto file = std::make_unique<File>(name);
+  index_ = IndexRecords(*file, name);
   depth_ = index_.FirstOfType(OniNodeType::kDepth);
   color_ = index_.FirstOfType(OniNodeType::kImage);
   if (!depth_) throw InputError(name + ": the recording has no depth stream");
@@ -369,14 +478,14 @@ void OniFileSource::Start() {
   } else {
     intrinsics_ = CameraIntrinsics::Carmine109().Scaled(depth_->width, depth_->height);
   }
-  mapping_ = std::move(mapping);
+  file_ = std::move(file);
   next_ = 0;
   color_cursor_ = 0;
   delivered_ = 0;
   skipped_ = 0;
 }
 
-void OniFileSource::Stop() { mapping_.reset(); }
+void OniFileSource::Stop() { file_.reset(); }
 
 bool OniFileSource::DecodesDepthCodec() const {
   return depth_ && (depth_->codec == kOniCodecNone || depth_->codec == kOniCodec16z ||
@@ -384,14 +493,16 @@ bool OniFileSource::DecodesDepthCodec() const {
 }
 
 SourceRead OniFileSource::Next(std::chrono::milliseconds) {
-  IHS_CHECK(mapping_ != nullptr, "OniFileSource::Next called before Start");
-  const std::string_view bytes = mapping_->bytes();
+  IHS_CHECK(file_ != nullptr, "OniFileSource::Next called before Start");
+  std::string_view payload;
+  OniFrameRecord at;
   while (next_ < depth_->frames.size()) {
     const OniFrameRecord& record = depth_->frames[next_++];
     auto frame = std::make_shared<Frame>();
     frame->width = depth_->width;
     frame->height = depth_->height;
-    if (!DecodeOniDepth(bytes, *depth_, record, frame->depth_mm)) {
+    if (!file_->Payload(record, payload, at) ||
+        !DecodeOniDepth(payload, *depth_, at, frame->depth_mm)) {
       ++skipped_;
       spdlog::warn("{}: skipping depth frame {}: its data cannot be decoded", path_.string(),
                    record.frame_number);
@@ -410,7 +521,8 @@ SourceRead OniFileSource::Next(std::chrono::milliseconds) {
         ++color_cursor_;
       }
       if (offset(color_cursor_) <= max_color_offset_us_ &&
-          DecodeOniColor(bytes, *color_, colors[color_cursor_], frame->rgb)) {
+          file_->Payload(colors[color_cursor_], payload, at) &&
+          DecodeOniColor(payload, *color_, at, frame->rgb)) {
         frame->color_timestamp_us = static_cast<std::int64_t>(colors[color_cursor_].timestamp_us);
       } else {
         frame->rgb.clear();

@@ -88,10 +88,12 @@ class OniFileSource : public FrameSource {
   explicit OniFileSource(std::filesystem::path path, std::int64_t max_color_offset_us = 34'000);
   ~OniFileSource() override;
 
-  /// Maps and indexes the file. Throws ihs::InputError naming the file when it is missing, not
-  /// an .oni recording, or holds no complete depth frame.
+  /// Indexes the file (read a piece at a time, never mapped whole: memory stays bounded by one
+  /// frame). Throws ihs::InputError naming the file when it is missing, not an .oni recording,
+  /// or holds no complete depth frame.
   void Start() override;
   void Stop() override;
+  /// Throws ihs::InputError when the file can no longer be read (cut short while it plays).
   SourceRead Next(std::chrono::milliseconds timeout) override;
   CameraIntrinsics Intrinsics() const override { return intrinsics_; }
   std::string Description() const override {
@@ -108,10 +110,10 @@ class OniFileSource : public FrameSource {
   bool DecodesDepthCodec() const;
 
  private:
-  struct Mapping;
+  class File;
   const std::filesystem::path path_;
   const std::int64_t max_color_offset_us_;
-  std::unique_ptr<Mapping> mapping_;
+  std::unique_ptr<File> file_;
   OniIndex index_;
   const OniNode* depth_ = nullptr;
   const OniNode* color_ = nullptr;

@@ -183,6 +183,36 @@ TEST(OniReaderTest, RecoversOurOwnRecordingCutOffMidWrite) {
   ExpectSameFrames(played, frames);
 }
 
+// Whether `path` is memory-mapped into this process.
+bool Mapped(const std::filesystem::path& path) {
+  return test::ReadFileString("/proc/self/maps").find(std::filesystem::canonical(path).string()) !=
+         std::string::npos;
+}
+
+TEST(OniReaderTest, ARecordingCutWhileItPlaysIsAnInputErrorAndNeverMapped) {
+  test::TempDir dir;
+  const auto frames = test::MakePatternFrames(6, 160, 120);
+  WriteOni(dir / "a.oni", frames, OniDepthCodec::k16zTable, 160, 120);
+  OniFileSource source(dir / "a.oni");
+  source.Start();
+  // Read a piece at a time: memory does not grow with the file's size.
+  EXPECT_FALSE(Mapped(dir / "a.oni"));
+  for (int i = 0; i < 2; ++i) {
+    const SourceRead read = source.Next(1s);
+    ASSERT_EQ(read.status, SourceStatus::kFrame);
+    EXPECT_EQ(read.frame->depth_mm, frames[i].depth_mm);
+  }
+  // Cut to half its size while it plays (a mapped file would raise SIGBUS here).
+  std::filesystem::resize_file(dir / "a.oni", std::filesystem::file_size(dir / "a.oni") / 2);
+  try {
+    for (int i = 2; i < 6; ++i) source.Next(1s);
+    FAIL() << "the frames past the cut were read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("a.oni: the file ends at byte"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(OniReaderTest, NonRecordingsAndEmptyRecordingsGetOneLineErrors) {
   test::TempDir dir;
   struct Case {
