@@ -47,9 +47,8 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("mask_ms", packet.mask_ms);
     timing("features_ms", packet.features_ms);
     entry["hand_pixels_removed"] = packet.hand_pixels_removed;
-    entry["sift_matches"] = packet.sift_matches;
-    entry["shot_matches"] = packet.shot_matches;
-    entry["contact_pairs"] = packet.contact_pairs;
+    nlohmann::json& matches = entry["matches"] = nlohmann::json::object();
+    for (const auto& [source, count] : packet.matches) matches[source] = count;
     if (!track.joints_mm.empty()) joints_.push_back({frame.index, track.joints_mm});
     if (track.HasPose()) {
       const Eigen::Quaterniond q = track.pose.cam_from_root.quaternion();

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "core/stopwatch.h"
+#include "fusion/correspondence_source.h"
 #include "fusion/object_mask.h"
 #include "fusion/shot_matcher.h"
 #include "fusion/sift_matcher.h"
@@ -94,10 +95,22 @@ void HandStage::Process(FramePacket& packet) {
   packet.mask_ms = MillisecondsSince(start);
 }
 
+std::vector<std::unique_ptr<fusion::CorrespondenceSource>> MakeCorrespondenceSources(
+    const ScannerOptions& options, const CameraIntrinsics& intrinsics) {
+  std::vector<std::unique_ptr<fusion::CorrespondenceSource>> sources;
+  if (options.scan.features_2d) {
+    sources.push_back(std::make_unique<fusion::SiftMatcher>(intrinsics, options.sift));
+  }
+  if (options.scan.features_3d) {
+    sources.push_back(std::make_unique<fusion::ShotMatcher>(intrinsics, options.shot));
+  }
+  sources.push_back(std::make_unique<fusion::HandContacts>());
+  return sources;
+}
+
 ObjectStage::ObjectStage(const ScannerOptions& options, const CameraIntrinsics& intrinsics)
     : options_(Checked(options).scan),
-      sift_(std::make_unique<fusion::SiftMatcher>(intrinsics, options.sift)),
-      shot_(std::make_unique<fusion::ShotMatcher>(intrinsics, options.shot)),
+      sources_(MakeCorrespondenceSources(options, intrinsics)),
       fusion_(intrinsics, options.fusion) {}
 
 ObjectStage::~ObjectStage() = default;
@@ -116,21 +129,18 @@ void ObjectStage::Process(FramePacket& packet) {
   fusion::FusionInput input;
   input.frame = &frame;
   input.object_mask = &packet.object_mask;
-  const auto start = SteadyClock::now();
-  if (options_.features_2d) {
-    input.correspondences.features_2d = sift_->Match(frame, packet.object_mask);
+  std::vector<fusion::PointMatch> hand_contacts;
+  for (const auto& pair : packet.track.contact_pairs) {
+    hand_contacts.push_back({pair.previous_mm, pair.current_mm, pair.vertex});
   }
-  if (options_.features_3d) {
-    input.correspondences.features_3d = shot_->Match(frame, packet.object_mask);
+  const fusion::MatchContext context{&frame, &packet.object_mask, &hand_contacts};
+  const auto start = SteadyClock::now();
+  for (const auto& source : sources_) {
+    input.correspondences.sets.push_back(source->MatchSetFor(context));
+    const fusion::MatchSet& set = input.correspondences.sets.back();
+    packet.matches.emplace_back(set.source, static_cast<int>(set.pairs.size()));
   }
   packet.features_ms = MillisecondsSince(start);
-  for (const auto& pair : packet.track.contact_pairs) {
-    input.correspondences.contacts.push_back({pair.previous_mm, pair.current_mm});
-    input.contact_ids.push_back(pair.vertex);
-  }
-  packet.sift_matches = static_cast<int>(input.correspondences.features_2d.size());
-  packet.shot_matches = static_cast<int>(input.correspondences.features_3d.size());
-  packet.contact_pairs = static_cast<int>(input.correspondences.contacts.size());
   if (packet.hand_mesh && packet.fingertips) {
     input.hand = packet.hand_mesh.get();
     input.fingertips = packet.fingertips.get();

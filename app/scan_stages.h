@@ -1,8 +1,9 @@
 #pragma once
 // The scanner's two per-frame stages as the pipeline's threads run them, and the packet that
 // carries a frame through them. HandStage: hand tracker, then the object's pixels without the
-// posed hand model. ObjectStage: SIFT (and optionally ISS3D + CSHOT) matches with the previous
-// frame plus the tracker's contact pairs, then registration, ICP and TSDF integration. Stage
+// posed hand model. ObjectStage: the correspondence sources' matches with the previous frame
+// (SIFT, optionally ISS3D + CSHOT, the tracker's contact pairs), then registration, ICP and
+// TSDF integration. Stage
 // objects know nothing of threads; inhandscan-scan runs them one after the other, the Pipeline
 // each on its own thread.
 
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/scanner_options.h"
@@ -20,8 +22,7 @@
 #include "tracker/hand_tracker.h"
 
 namespace ihs::fusion {
-class SiftMatcher;
-class ShotMatcher;
+class CorrespondenceSource;
 }  // namespace ihs::fusion
 
 namespace ihs::app {
@@ -49,9 +50,8 @@ struct FramePacket {
 
   // Filled by ObjectStage.
   fusion::FusionResult fusion;
-  int sift_matches = 0;
-  int shot_matches = 0;
-  int contact_pairs = 0;
+  /// Each correspondence source's pairs with the previous frame, by its name (in order).
+  std::vector<std::pair<std::string, int>> matches;
   double features_ms = 0;
   /// From capture to fused, ms (set by whoever runs the stages).
   double latency_ms = 0;
@@ -92,6 +92,13 @@ class HandStage {
   std::shared_ptr<const std::vector<std::vector<int>>> fingertips_;
 };
 
+/// The correspondence sources the options turn on, in the registration's order: SIFT
+/// (scan.features_2d), ISS3D + CSHOT (scan.features_3d), the hand's contacts (always; γt = 0,
+/// fusion.pairwise.contact_weight, leaves them out of the registration). The one place that
+/// names them: a new source is one line here and one option.
+std::vector<std::unique_ptr<fusion::CorrespondenceSource>> MakeCorrespondenceSources(
+    const ScannerOptions& options, const CameraIntrinsics& intrinsics);
+
 /// Correspondences, registration, ICP and the TSDF: the model belongs to this stage.
 class ObjectStage {
  public:
@@ -109,8 +116,7 @@ class ObjectStage {
 
  private:
   const ScanOptions options_;
-  std::unique_ptr<fusion::SiftMatcher> sift_;
-  std::unique_ptr<fusion::ShotMatcher> shot_;
+  std::vector<std::unique_ptr<fusion::CorrespondenceSource>> sources_;
   fusion::ObjectFusion fusion_;
 };
 

@@ -60,52 +60,53 @@ FusionResult ObjectFusion::Skip(std::string reason) const {
   return result;
 }
 
-int ObjectFusion::AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
-                                   std::vector<int>* contact_ids) const {
+int ObjectFusion::AddModelContacts(const FusionInput& input,
+                                   std::vector<PointMatch>* contacts) const {
   if (!options_.model_contacts.enabled || !input.hand || !input.fingertips ||
       previous_hand_.empty() || !started_) {
     return 0;
   }
   // Without ids the tracker's contacts cannot be told apart from the model's: none added.
-  if (contact_ids->size() != correspondences->contacts.size()) return 0;
+  std::vector<int> known;
+  for (const PointMatch& contact : *contacts) {
+    if (contact.id < 0) return 0;
+    known.push_back(contact.id);
+  }
   const std::vector<ModelContact> found =
       FindModelContacts(volume_, cam_from_object_.Inverse(), previous_hand_, input.hand->vertices,
                         *input.fingertips, options_.model_contacts);
-  std::vector<int> known = *contact_ids;
   std::sort(known.begin(), known.end());
   int added = 0;
   for (const ModelContact& contact : found) {
     if (std::binary_search(known.begin(), known.end(), contact.vertex)) continue;
-    correspondences->contacts.push_back({contact.previous, contact.current});
-    contact_ids->push_back(contact.vertex);
+    contacts->push_back({contact.previous, contact.current, contact.vertex});
     ++added;
   }
   return added;
 }
 
-int ObjectFusion::ApplyAnchors(const std::vector<int>& contact_ids,
-                               PairwiseInput* correspondences) const {
-  if (!options_.anchor_contacts || contact_ids.empty()) return 0;
+int ObjectFusion::ApplyAnchors(std::vector<PointMatch>* contacts) const {
+  if (!options_.anchor_contacts) return 0;
   int anchored = 0;
-  for (size_t i = 0; i < correspondences->contacts.size(); ++i) {
-    const auto found = anchors_.find(contact_ids[i]);
+  for (PointMatch& contact : *contacts) {
+    const auto found = contact.id < 0 ? anchors_.end() : anchors_.find(contact.id);
     if (found == anchors_.end()) continue;
-    correspondences->contacts[i].previous = cam_from_object_ * found->second.object_point;
+    contact.previous = cam_from_object_ * found->second.object_point;
     ++anchored;
   }
   return anchored;
 }
 
-void ObjectFusion::UpdateAnchors(const std::vector<int>& contact_ids,
-                                 const std::vector<PointMatch>& contacts,
+void ObjectFusion::UpdateAnchors(const std::vector<PointMatch>& contacts,
                                  const Rigid3& cam_from_object) {
   std::unordered_map<int, Anchor> held;
-  if (options_.anchor_contacts && !contact_ids.empty()) {
+  if (options_.anchor_contacts) {
     const Rigid3 object_from_cam = cam_from_object.Inverse();
-    for (size_t i = 0; i < contact_ids.size(); ++i) {
-      const Eigen::Vector3d seen = object_from_cam * contacts[i].current;
+    for (const PointMatch& contact : contacts) {
+      if (contact.id < 0) continue;
+      const Eigen::Vector3d seen = object_from_cam * contact.current;
       Anchor anchor{seen, 1};
-      const auto found = anchors_.find(contact_ids[i]);
+      const auto found = anchors_.find(contact.id);
       if (found != anchors_.end() &&
           (found->second.object_point - seen).norm() <= options_.anchor_slip_mm) {
         // The running mean of where the contact has been seen.
@@ -113,7 +114,7 @@ void ObjectFusion::UpdateAnchors(const std::vector<int>& contact_ids,
         ++anchor.observations;
         anchor.object_point += (seen - anchor.object_point) / anchor.observations;
       }
-      held[contact_ids[i]] = anchor;
+      held[contact.id] = anchor;
     }
   }
   anchors_ = std::move(held);
@@ -126,9 +127,6 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const Frame& frame = *input.frame;
   const std::vector<std::uint8_t>& mask = *input.object_mask;
   IHS_CHECK_ARG(mask.size() == frame.depth_mm.size(), "the object mask does not fit the frame");
-  IHS_CHECK_ARG(input.contact_ids.empty() ||
-                    input.contact_ids.size() == input.correspondences.contacts.size(),
-                "contact_ids must be empty or one per contact");
   FusionResult result;
   result.cam_from_object = cam_from_object_;
   auto finish = [&](FusionStatus status, std::string reason = {}) {
@@ -186,10 +184,18 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   // The correspondences' motion, then ICP from there.
   Rigid3 pose = cam_from_object_;
   const auto pairwise_start = SteadyClock::now();
-  PairwiseInput correspondences = input.correspondences;
-  std::vector<int> contact_ids = input.contact_ids;
-  result.model_contacts = AddModelContacts(input, &correspondences, &contact_ids);
-  result.anchored_contacts = ApplyAnchors(contact_ids, &correspondences);
+  // The contact sets as one, with the model's contacts and the anchors.
+  PairwiseInput correspondences;
+  std::vector<PointMatch> contacts;
+  for (const MatchSet& set : input.correspondences.sets) {
+    if (set.kind == MatchKind::kVisual) correspondences.sets.push_back(set);
+    if (set.kind == MatchKind::kContact) {
+      contacts.insert(contacts.end(), set.pairs.begin(), set.pairs.end());
+    }
+  }
+  result.model_contacts = AddModelContacts(input, &contacts);
+  result.anchored_contacts = ApplyAnchors(&contacts);
+  correspondences.sets.push_back({"contacts", MatchKind::kContact, contacts});
   result.pairwise = RegisterPair(correspondences, options_.pairwise);
   result.pairwise_ms = MillisecondsSince(pairwise_start);
   if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
@@ -206,11 +212,11 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     const bool spread =
         result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm;
     if (options_.pairwise.contact_weight > 0 &&
-        static_cast<int>(correspondences.contacts.size()) >= options_.pairwise.min_contacts &&
+        static_cast<int>(contacts.size()) >= options_.pairwise.min_contacts &&
         (!options_.icp_contacts_need_spread || (result.pairwise.ok && spread))) {
       const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
       const double inlier_sq = options_.pairwise.inlier_mm * options_.pairwise.inlier_mm;
-      for (const PointMatch& contact : correspondences.contacts) {
+      for (const PointMatch& contact : contacts) {
         // Where feature matches fixed the motion, a contact they contradict is a mistracked
         // fingertip (see PairwiseOptions::check_contacts): it must not steer what the surface
         // leaves free and the features saw (a flat face's sliding). This is checked against the
@@ -289,10 +295,10 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   // How far the contacts land from the final motion: their noise, for the next frames' weight.
   // Only where they held ICP (a frame whose registration did without them may have lost the
   // turn they saw, and that is not their noise).
-  if (!correspondences.contacts.empty() && options_.pairwise.contact_weight > 0 &&
-      result.pairwise.ok && result.icp.ok && !result.icp_from_previous) {
+  if (!contacts.empty() && options_.pairwise.contact_weight > 0 && result.pairwise.ok &&
+      result.icp.ok && !result.icp_from_previous) {
     std::vector<double> residuals;
-    for (const PointMatch& contact : correspondences.contacts)
+    for (const PointMatch& contact : contacts)
       residuals.push_back((step * contact.previous - contact.current).norm());
     std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
     result.contact_residual_mm = residuals[residuals.size() / 2];
@@ -308,7 +314,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
   result.integrate_ms = MillisecondsSince(integrate_start);
   free_space_.Observe(frame, box, pose, input.hand);
-  UpdateAnchors(contact_ids, correspondences.contacts, pose);
+  UpdateAnchors(contacts, pose);
   return finish(FusionStatus::kFused);
 }
 

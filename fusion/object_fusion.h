@@ -80,15 +80,14 @@ struct FusionInput {
   const Frame* frame = nullptr;
   /// Per pixel: non-zero where the object is (the tracker's object mask).
   const std::vector<std::uint8_t>* object_mask = nullptr;
-  /// Correspondences with the previous frame (camera frame, mm).
+  /// Correspondences with the previous frame (camera frame, mm), one set per source
+  /// (correspondence_source.h). A contact pair with an id (the touching skin point's vertex) is
+  /// anchored while its grasp holds (FusionOptions::anchor_contacts); one without is not.
   PairwiseInput correspondences;
-  /// For each of `correspondences.contacts`, what identifies the touching skin point from
-  /// frame to frame (the hand model's vertex index); empty: contacts are not anchored.
-  std::vector<int> contact_ids;
   /// The posed hand model in this frame (camera frame, mm) and each fingertip's vertex
   /// indices: with both, fingertips on the model's surface are contacts too
-  /// (FusionOptions::model_contacts). Null: only `correspondences.contacts`. The hand's volume
-  /// is space the object is not in (free_space.h).
+  /// (FusionOptions::model_contacts). Null: only the contact sets of `correspondences`. The
+  /// hand's volume is space the object is not in (free_space.h).
   const TriangleMesh* hand = nullptr;
   const std::vector<std::vector<int>>* fingertips = nullptr;
 };
@@ -169,16 +168,14 @@ class ObjectFusion {
   const FusionOptions& options() const { return options_; }
 
  private:
-  // Adds the fingertip contacts found against the model that `contact_ids` lacks; returns how
-  // many pairs.
-  int AddModelContacts(const FusionInput& input, PairwiseInput* correspondences,
-                       std::vector<int>* contact_ids) const;
+  // Adds the fingertip contacts found against the model that `contacts` lacks (by id); returns
+  // how many pairs.
+  int AddModelContacts(const FusionInput& input, std::vector<PointMatch>* contacts) const;
   // Replaces the previous-frame positions of anchored contacts by their anchors (seen from the
   // previous pose); returns how many.
-  int ApplyAnchors(const std::vector<int>& contact_ids, PairwiseInput* correspondences) const;
+  int ApplyAnchors(std::vector<PointMatch>* contacts) const;
   // After registering at `cam_from_object`: anchors of the contacts still held, updated.
-  void UpdateAnchors(const std::vector<int>& contact_ids, const std::vector<PointMatch>& contacts,
-                     const Rigid3& cam_from_object);
+  void UpdateAnchors(const std::vector<PointMatch>& contacts, const Rigid3& cam_from_object);
 
   struct Anchor {
     Eigen::Vector3d object_point;

@@ -25,6 +25,22 @@ void PairwiseOptions::Check() const {
   IHS_CHECK_ARG(visual_turn_prior_deg >= 0, "pairwise.visual_turn_prior_deg must be >= 0");
 }
 
+std::vector<PointMatch>& PairwiseInput::Pairs(const std::string& source, MatchKind kind) {
+  for (MatchSet& set : sets) {
+    if (set.source == source) return set.pairs;
+  }
+  sets.push_back({source, kind, {}});
+  return sets.back().pairs;
+}
+
+std::vector<PointMatch> PairwiseInput::All(MatchKind kind) const {
+  std::vector<PointMatch> all;
+  for (const MatchSet& set : sets) {
+    if (set.kind == kind) all.insert(all.end(), set.pairs.begin(), set.pairs.end());
+  }
+  return all;
+}
+
 namespace {
 
 // The largest set of visual pairs consistent with one rigid motion (hypotheses from three
@@ -124,17 +140,28 @@ VisualFit FitVisual(const std::vector<PointMatch>& matches) {
   return fit;
 }
 
+// "12 sift and 0 shot": the pairs of each set of `kind` ("no" without a set).
+std::string Counts(const PairwiseInput& input, MatchKind kind) {
+  std::vector<std::string> parts;
+  for (const MatchSet& set : input.sets) {
+    if (set.kind == kind) parts.push_back(std::to_string(set.pairs.size()) + " " + set.source);
+  }
+  if (parts.empty()) return "no";
+  std::string text = parts.front();
+  for (size_t i = 1; i < parts.size(); ++i) {
+    text += (i + 1 == parts.size() ? " and " : ", ") + parts[i];
+  }
+  return text;
+}
+
 }  // namespace
 
 PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& options) {
   options.Check();
   PairwiseResult result;
   std::vector<PointMatch> visual;
-  if (options.visual_weight > 0) {
-    visual = input.features_2d;
-    visual.insert(visual.end(), input.features_3d.begin(), input.features_3d.end());
-    visual = RansacInliers(visual, options);
-  }
+  if (options.visual_weight > 0) visual = RansacInliers(input.All(MatchKind::kVisual), options);
+  const std::vector<PointMatch> input_contacts = input.All(MatchKind::kContact);
   // RansacInliers returns a set of at least min_visual_inliers (>= 3) pairs, or none.
   VisualFit visual_fit;
   if (!visual.empty()) {
@@ -151,13 +178,13 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
   std::vector<PointMatch> contacts;
   if (options.check_contacts && !visual.empty() && options.contact_weight > 0) {
     const double inlier_sq = options.inlier_mm * options.inlier_mm;
-    for (const PointMatch& m : input.contacts) {
+    for (const PointMatch& m : input_contacts) {
       if ((visual_fit.motion * m.previous - m.current).squaredNorm() < inlier_sq)
         contacts.push_back(m);
     }
-    result.contacts_rejected = static_cast<int>(input.contacts.size() - contacts.size());
+    result.contacts_rejected = static_cast<int>(input_contacts.size() - contacts.size());
   } else {
-    contacts = input.contacts;
+    contacts = input_contacts;
   }
   const double spread = Spread(contacts);
   result.contact_spread_mm = spread;
@@ -165,12 +192,11 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
                             (static_cast<int>(contacts.size()) >= options.min_contacts ||
                              (!visual.empty() && !contacts.empty()));
   if (visual.empty() && !use_contacts) {
-    result.reason = "too few correspondences: " + std::to_string(input.features_2d.size()) +
-                    " 2D and " + std::to_string(input.features_3d.size()) +
-                    " 3D feature matches (no consistent set of " +
+    result.reason = "too few correspondences: " + Counts(input, MatchKind::kVisual) +
+                    " feature matches (no consistent set of " +
                     std::to_string(options.min_visual_inliers) + "), " +
-                    std::to_string(input.contacts.size()) + " contacts" +
-                    (input.contacts.empty()
+                    std::to_string(input_contacts.size()) + " contacts" +
+                    (input_contacts.empty()
                          ? ""
                          : " spread over " + std::to_string(std::lround(spread)) + " mm (need " +
                                std::to_string(std::lround(options.min_contact_spread_mm)) + ")");

@@ -1,9 +1,10 @@
 #pragma once
 // The paper's pairwise registration (§3.3): the object's motion between the previous and the
-// current frame from three sets of corresponding object points — SIFT matches back-projected to
-// 3D, ISS3D + CSHOT matches, and the fingertip contacts the hand tracker holds — as the rigid
-// transform minimising E = E_feat2d + E_feat3d + γt·E_contact (sums of squared point distances).
-// The visual sets are cleaned by RANSAC first; the contacts come from the tracker and are kept.
+// current frame from sets of corresponding object points — in the paper SIFT matches
+// back-projected to 3D, ISS3D + CSHOT matches, and the fingertip contacts the hand tracker holds;
+// here whatever sources correspondence_source.h lists — as the rigid transform minimising
+// E = E_feat2d + E_feat3d + γt·E_contact (sums of squared point distances). The visual sets are
+// cleaned by RANSAC first; the contacts come from the tracker and are kept.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -18,13 +19,31 @@ namespace ihs::fusion {
 struct PointMatch {
   Eigen::Vector3d previous;
   Eigen::Vector3d current;
+  /// What identifies the point from frame to frame where its source knows it (a contact's
+  /// touching skin point: the hand model's vertex index); -1: nothing.
+  int id = -1;
 };
 
-/// The correspondences of one frame pair.
+/// How the registration uses a set of pairs: visual pairs (features) are cleaned by RANSAC
+/// together and weigh PairwiseOptions::visual_weight each; contact pairs come from the hand, are
+/// checked against the visual motion and weigh γt (PairwiseOptions::contact_weight).
+enum class MatchKind { kVisual, kContact };
+
+/// One source's pairs (correspondence_source.h), by the source's name.
+struct MatchSet {
+  std::string source;
+  MatchKind kind = MatchKind::kVisual;
+  std::vector<PointMatch> pairs;
+};
+
+/// The correspondences of one frame pair, one set per source.
 struct PairwiseInput {
-  std::vector<PointMatch> features_2d;  ///< SIFT matches, back-projected.
-  std::vector<PointMatch> features_3d;  ///< ISS3D + CSHOT matches.
-  std::vector<PointMatch> contacts;     ///< Contact vertices held in both frames.
+  std::vector<MatchSet> sets;
+
+  /// The pairs of `source`; an empty set of `kind` is added when there is none.
+  std::vector<PointMatch>& Pairs(const std::string& source, MatchKind kind);
+  /// Every pair of `kind`, in the sets' order.
+  std::vector<PointMatch> All(MatchKind kind) const;
 };
 
 /// Options of the pairwise registration (defaults: the paper's γt; RANSAC as usual).

@@ -155,4 +155,10 @@ std::vector<PointMatch> ShotMatcher::Match(const Frame& frame,
   return matches;
 }
 
+std::vector<PointMatch> ShotMatcher::Match(const MatchContext& context) {
+  IHS_CHECK_ARG(context.frame != nullptr && context.object_mask != nullptr,
+                "ShotMatcher needs a frame and its object mask");
+  return Match(*context.frame, *context.object_mask);
+}
+
 }  // namespace ihs::fusion

@@ -6,11 +6,12 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
-#include "fusion/pairwise_registration.h"
+#include "fusion/correspondence_source.h"
 
 namespace ihs::fusion {
 
@@ -34,10 +35,15 @@ struct ShotOptions {
 };
 
 /// Matches each frame's object keypoints with the previous frame's. Not thread-safe.
-class ShotMatcher {
+class ShotMatcher final : public CorrespondenceSource {
  public:
   explicit ShotMatcher(const CameraIntrinsics& intrinsics, ShotOptions options = {});
-  ~ShotMatcher();
+  ~ShotMatcher() override;
+
+  std::string name() const override { return "shot"; }
+  MatchKind kind() const override { return MatchKind::kVisual; }
+  /// Match(frame, object_mask) of the context's frame.
+  std::vector<PointMatch> Match(const MatchContext& context) override;
 
   /// The ISS3D keypoints of the object's points (`object_mask` non-zero, with depth), matched by
   /// CSHOT with those of the previous call: (previous, current) 3D points, camera frame, mm.

@@ -97,4 +97,10 @@ std::vector<PointMatch> SiftMatcher::Match(const Frame& frame,
   return matches;
 }
 
+std::vector<PointMatch> SiftMatcher::Match(const MatchContext& context) {
+  IHS_CHECK_ARG(context.frame != nullptr && context.object_mask != nullptr,
+                "SiftMatcher needs a frame and its object mask");
+  return Match(*context.frame, *context.object_mask);
+}
+
 }  // namespace ihs::fusion

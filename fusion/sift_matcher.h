@@ -6,11 +6,12 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
-#include "fusion/pairwise_registration.h"
+#include "fusion/correspondence_source.h"
 
 namespace ihs::fusion {
 
@@ -26,10 +27,15 @@ struct SiftOptions {
 };
 
 /// Matches each frame's object keypoints with the previous frame's. Not thread-safe.
-class SiftMatcher {
+class SiftMatcher final : public CorrespondenceSource {
  public:
   explicit SiftMatcher(const CameraIntrinsics& intrinsics, SiftOptions options = {});
-  ~SiftMatcher();
+  ~SiftMatcher() override;
+
+  std::string name() const override { return "sift"; }
+  MatchKind kind() const override { return MatchKind::kVisual; }
+  /// Match(frame, object_mask) of the context's frame.
+  std::vector<PointMatch> Match(const MatchContext& context) override;
 
   /// The keypoints of `frame` inside `object_mask` (non-zero pixels, with depth), matched with
   /// those of the previous call: (previous, current) 3D points, camera frame, mm. The first

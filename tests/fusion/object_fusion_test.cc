@@ -59,14 +59,14 @@ SequenceRun FuseSequence(const Eigen::Vector3d& semi_axes, int contacts,
     const Frame frame = test::RenderEllipsoid(kIntrinsics, Truth(i), semi_axes);
     std::vector<std::uint8_t> mask(frame.depth_mm.size());
     for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
-    FusionInput input{&frame, &mask, {}, {}};
+    FusionInput input{&frame, &mask, {}};
     if (i > 0) {
       Eigen::Vector3d shared = Eigen::Vector3d::Zero();
       if (shared_noise_mm > 0) shared = {shared_noise(rng), shared_noise(rng), shared_noise(rng)};
       for (const Eigen::Vector3d& q : touched) {
-        input.correspondences.contacts.push_back(
-            {Truth(i - 1) * q,
-             Truth(i) * q + shared + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))});
+        input.correspondences.Pairs("contacts", MatchKind::kContact)
+            .push_back({Truth(i - 1) * q, Truth(i) * q + shared +
+                                              Eigen::Vector3d(noise(rng), noise(rng), noise(rng))});
       }
     }
     run.results.push_back(fusion.Fuse(input));
@@ -211,10 +211,11 @@ TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   for (size_t p = 0; p < mask.size(); ++p) mask[p] = first.depth_mm[p] != 0;
   EXPECT_EQ(fusion.Fuse({&first, &mask, {}, {}}).status, FusionStatus::kStarted);
   // Contacts that claim the object jumped 80 mm: not integrated.
-  FusionInput jump{&first, &mask, {}, {}};
+  FusionInput jump{&first, &mask, {}};
   for (int k = 0; k < 5; ++k) {
     const Eigen::Vector3d p = Truth(0) * Eigen::Vector3d(10.0 * k, 5.0 * k * k, 1.0 * k);
-    jump.correspondences.contacts.push_back({p, p + Eigen::Vector3d(80, 0, 0)});
+    jump.correspondences.Pairs("contacts", MatchKind::kContact)
+        .push_back({p, p + Eigen::Vector3d(80, 0, 0)});
   }
   FusionOptions no_icp;
   no_icp.use_icp = false;

@@ -54,9 +54,9 @@ Scene MakeScene(std::mt19937& rng, int matches_2d, int matches_3d, int contacts,
       set.push_back({p, q});
     }
   };
-  add(scene.input.features_2d, matches_2d, 1.0, outliers);
-  add(scene.input.features_3d, matches_3d, 1.5, outliers);
-  add(scene.input.contacts, contacts, 0.5, 0.0);
+  add(scene.input.Pairs("sift", MatchKind::kVisual), matches_2d, 1.0, outliers);
+  add(scene.input.Pairs("shot", MatchKind::kVisual), matches_3d, 1.5, outliers);
+  add(scene.input.Pairs("contacts", MatchKind::kContact), contacts, 0.5, 0.0);
   return scene;
 }
 
@@ -86,7 +86,7 @@ TEST(PairwiseRegistrationTest, EachSetAloneStillGivesTheMotion) {
   EXPECT_LT(MotionError(visual.current_from_previous, scene.truth), 1.0);
 
   PairwiseInput contacts_only = scene.input;
-  contacts_only.features_2d.clear();
+  contacts_only.Pairs("sift", MatchKind::kVisual).clear();
   const PairwiseResult contacts = RegisterPair(contacts_only);
   ASSERT_TRUE(contacts.ok) << contacts.reason;
   EXPECT_EQ(contacts.visual_inliers, 0);
@@ -99,7 +99,8 @@ TEST(PairwiseRegistrationTest, ContactsTheFeaturesContradictAreDropped) {
   // Measured: all 30 dropped, motion error 0.55 mm (7.11 mm unchecked).
   std::mt19937 rng = test::Rng(2);
   Scene scene = MakeScene(rng, 80, 0, 30, 0.2);
-  for (PointMatch& contact : scene.input.contacts) contact.current += Eigen::Vector3d(8, 0, 0);
+  for (PointMatch& contact : scene.input.Pairs("contacts", MatchKind::kContact))
+    contact.current += Eigen::Vector3d(8, 0, 0);
   const PairwiseResult checked = RegisterPair(scene.input);
   PairwiseOptions unchecked_options;
   unchecked_options.check_contacts = false;
@@ -148,8 +149,8 @@ TEST(PairwiseRegistrationTest, VisualMatchesAloneKeepOnlyTheTurnTheyFix) {
     for (int i = 0; i < 7; ++i) {
       const Eigen::Vector3d p =
           centre + 40 * Eigen::Vector3d(6 * unit(rng) / 40, 6 * unit(rng) / 40, -1).normalized();
-      input.features_2d.push_back(
-          {p, truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))});
+      input.Pairs("sift", MatchKind::kVisual)
+          .push_back({p, truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))});
       patch_centre += p / 7;
     }
     const PairwiseResult shrunk = RegisterPair(input);
@@ -182,6 +183,31 @@ TEST(PairwiseRegistrationTest, VisualMatchesAloneKeepOnlyTheTurnTheyFix) {
   EXPECT_LT(MotionError(kept.current_from_previous, spread.truth), 0.6);
 }
 
+// A correspondence source is one more set: its kind decides how it weighs, its name only what
+// the messages call it.
+TEST(PairwiseRegistrationTest, AnySourcesSetCountsByItsKind) {
+  std::mt19937 rng = test::Rng(3);
+  Scene scene = MakeScene(rng, 0, 0, 12, 0.0);
+  const PairwiseResult contacts = RegisterPair(scene.input);
+  ASSERT_TRUE(contacts.ok) << contacts.reason;
+  EXPECT_EQ(contacts.contacts, 12);
+  // Finger pads as a second contact source: their pairs join the fingertips'.
+  const Scene more = MakeScene(rng, 0, 0, 5, 0.0);
+  PairwiseInput with_pads = scene.input;
+  with_pads.Pairs("pads", MatchKind::kContact) = more.input.All(MatchKind::kContact);
+  const PairwiseResult pads = RegisterPair(with_pads);
+  ASSERT_TRUE(pads.ok) << pads.reason;
+  EXPECT_EQ(pads.contacts, 17);
+  // Visual pairs under another name are visual pairs: RANSAC keeps the consistent ones.
+  PairwiseInput visual;
+  visual.Pairs("depth edges", MatchKind::kVisual) =
+      MakeScene(rng, 40, 0, 0, 0.0).input.All(MatchKind::kVisual);
+  const PairwiseResult edges = RegisterPair(visual);
+  ASSERT_TRUE(edges.ok) << edges.reason;
+  EXPECT_GE(edges.visual_inliers, 36);  // Of 40, with 1 mm noise per axis.
+  EXPECT_EQ(edges.contacts, 0);
+}
+
 TEST(PairwiseRegistrationTest, NothingToGoOnIsASkippedFrameWithItsReason) {
   const PairwiseResult none = RegisterPair({});
   EXPECT_FALSE(none.ok);
@@ -189,7 +215,10 @@ TEST(PairwiseRegistrationTest, NothingToGoOnIsASkippedFrameWithItsReason) {
   // Two contacts and a handful of inconsistent matches are not enough either.
   std::mt19937 rng = test::Rng(2);
   Scene scene = MakeScene(rng, 8, 0, 2, 1.0);
-  EXPECT_FALSE(RegisterPair(scene.input).ok);
+  const PairwiseResult few = RegisterPair(scene.input);
+  EXPECT_FALSE(few.ok);
+  // The reason names each source's matches.
+  EXPECT_NE(few.reason.find("8 sift and 0 shot feature matches"), std::string::npos) << few.reason;
   PairwiseOptions bad;
   bad.contact_weight = -1;
   EXPECT_THROW(RegisterPair(scene.input, bad), std::invalid_argument);

@@ -51,7 +51,7 @@ TEST(ShotMatcherTest, MatchesBetweenTwoViewsOfABoxGiveBackItsMotion) {
   const Frame b = RenderBox(renderer, box, about_centre * first);
   const std::vector<PointMatch> matches = matcher.Match(b, MaskOf(b));
   PairwiseInput input;
-  input.features_3d = matches;
+  input.Pairs("shot", MatchKind::kVisual) = matches;
   PairwiseOptions options;
   options.min_visual_inliers = 4;
   options.visual_turn_prior_deg = 0;  // The matches' own motion: no prior on the 4.6° turn.

@@ -57,7 +57,9 @@ TEST(SiftMatcherTest, MatchesOfATexturedSquareGiveItsMotion) {
   const std::vector<PointMatch> matches = matcher.Match(b, DepthMask(b));
   PairwiseOptions visual_only;
   visual_only.contact_weight = 0;
-  const PairwiseResult result = RegisterPair({matches, {}, {}}, visual_only);
+  PairwiseInput input;
+  input.Pairs(matcher.name(), matcher.kind()) = matches;
+  const PairwiseResult result = RegisterPair(input, visual_only);
   ASSERT_TRUE(result.ok) << result.reason;
   double worst = 0;
   for (double x : {-70.0, 70.0})
