@@ -81,6 +81,7 @@ struct ScanArgs {
   bool window = false;
   std::string screenshot;
   bool realtime = false;
+  int loops = 1;
   std::string device;
   std::string input;
 };
@@ -310,6 +311,10 @@ int main(int argc, char** argv) {
   replay->add_flag("--realtime", args.realtime,
                    "pace frames at their timestamps and drop frames as live would");
   replay->add_flag("--window", args.window, "show the live window while replaying");
+  replay
+      ->add_option("--loop", args.loops,
+                   "play the recording this many times over, as one long input (a soak run)")
+      ->check(CLI::Range(1, 1000));
   add_output(replay);
   std::string record_path;
   double record_seconds = 0;
@@ -384,6 +389,7 @@ int main(int argc, char** argv) {
     ihs::sensor::InputOptions input_options;
     input_options.pacing =
         args.realtime ? ihs::sensor::Pacing::kRealTime : ihs::sensor::Pacing::kAsFastAsPossible;
+    input_options.loops = args.loops;
     return Scan(ihs::sensor::OpenInput(args.input, input_options), options, args, args.window,
                 quiet);
   });

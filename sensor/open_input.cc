@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "sensor/looping_source.h"
 #include "sensor/oni_reader.h"
 #include "sensor/openni_source.h"
 #include "sensor/paced_source.h"
@@ -63,9 +64,7 @@ class AutoOniSource : public FrameSource {
   std::unique_ptr<FrameSource> active_;
 };
 
-}  // namespace
-
-std::unique_ptr<FrameSource> OpenInput(const std::string& input, const InputOptions& options) {
+std::unique_ptr<FrameSource> OpenOnce(const std::string& input, const InputOptions& options) {
   std::error_code ec;
   if (std::filesystem::is_directory(input, ec)) {
     return WithPacing(std::make_unique<TumDirectorySource>(input, options.tum), options.pacing);
@@ -86,6 +85,12 @@ std::unique_ptr<FrameSource> OpenInput(const std::string& input, const InputOpti
       break;
   }
   return std::make_unique<AutoOniSource>(input, options.pacing);
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenInput(const std::string& input, const InputOptions& options) {
+  return Looped(OpenOnce(input, options), options.loops);
 }
 
 }  // namespace ihs::sensor

@@ -25,6 +25,8 @@ struct InputOptions {
   OniBackend oni_backend = OniBackend::kAuto;
   /// Options for TUM folders (depth scale, association tolerance, intrinsics).
   TumOptions tum;
+  /// Times the recording is played over (looping_source.h; >= 1).
+  int loops = 1;
 };
 
 /// A source for `input` (not yet started): an .oni file or a TUM folder. Throws ihs::InputError
