@@ -18,6 +18,7 @@
 #include "core/check.h"
 #include "core/data_lines.h"
 #include "core/errors.h"
+#include "sensor/png_decoder.h"
 
 namespace ihs::sensor {
 namespace fs = std::filesystem;
@@ -78,6 +79,7 @@ cv::Mat ReadImage(const fs::path& path, int flags, std::string* problem) {
                std::to_string(height) + " pixels, more than a depth camera's frame can have";
     return {};
   }
+  if (IsPng(bytes)) return DecodePng(bytes, flags == cv::IMREAD_ANYDEPTH, kMaxImagePixels, problem);
   cv::Mat image;
   if (!bytes.empty()) {
     try {

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
@@ -93,6 +94,54 @@ TEST(TumDirectoryTest, UnreadableImagesAreSkippedAndCounted) {
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(source.SkippedFrames(), 2);
   EXPECT_EQ(frames[1]->index, 1);  // Indices count delivered frames.
+}
+
+// Damaged PNGs are decoded by libpng directly: the frame is skipped with the scanner's one-line
+// warning naming libpng's reason, and libpng prints nothing of its own (through OpenCV it printed
+// "libpng error: IDAT: incorrect data check" lines beside it).
+TEST(TumDirectoryTest, DamagedPngsAreSkippedWithOneLineAndLibpngSaysNothing) {
+  test::TempDir dir;
+  WriteFrames(dir.path(), test::MakePatternFrames(4, 64, 48), CameraIntrinsics{}.Scaled(64, 48));
+  const auto entries = ListTumDirectory(dir.path(), TumOptions{});
+  std::string depth = test::ReadFileString(dir / entries[1].depth_path);
+  depth[depth.find("IDAT") + 40] ^= 0x5A;  // Compressed data that no longer checks.
+  test::WriteBytes(dir / entries[1].depth_path, depth);
+  const std::string colour = test::ReadFileString(dir / entries[2].color_path);
+  test::WriteBytes(dir / entries[2].color_path, colour.substr(0, colour.size() / 2));
+  TumDirectorySource source(dir.path());
+  testing::internal::CaptureStderr();
+  const auto frames = test::ReadAllFrames(source);
+  const std::string printed = testing::internal::GetCapturedStderr();
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(source.SkippedFrames(), 2);
+  EXPECT_EQ(printed.find("libpng"), std::string::npos) << printed;
+}
+
+// Colour images in PNG's other forms (grey, colour with alpha) read as the same colours.
+TEST(TumDirectoryTest, ColourPngsOfEveryKindReadAsTheirColours) {
+  test::TempDir dir;
+  auto frames = test::MakePatternFrames(1, 16, 12);
+  for (size_t p = 0; p < frames[0].rgb.size(); p += 3) {
+    frames[0].rgb[p + 1] = frames[0].rgb[p + 2] = frames[0].rgb[p];  // Grey.
+  }
+  WriteFrames(dir.path(), frames, CameraIntrinsics{}.Scaled(16, 12));
+  const auto entries = ListTumDirectory(dir.path(), TumOptions{});
+  cv::Mat grey(12, 16, CV_8UC1), with_alpha(12, 16, CV_8UC4);
+  for (int i = 0; i < 16 * 12; ++i) {
+    grey.data[i] = frames[0].rgb[3 * i];
+    for (int c = 0; c < 3; ++c) with_alpha.data[4 * i + c] = frames[0].rgb[3 * i];
+    with_alpha.data[4 * i + 3] = 255;
+  }
+  for (const cv::Mat& image : {grey, with_alpha}) {
+    std::vector<std::uint8_t> png;
+    ASSERT_TRUE(cv::imencode(".png", image, png));
+    test::WriteBytes(dir / entries[0].color_path, std::string(png.begin(), png.end()));
+    TumDirectorySource source(dir.path());
+    const auto read = test::ReadAllFrames(source);
+    ASSERT_EQ(read.size(), 1u);
+    EXPECT_EQ(read[0]->rgb, frames[0].rgb) << image.channels() << " channels";
+    EXPECT_EQ(read[0]->depth_mm, frames[0].depth_mm);
+  }
 }
 
 TEST(TumDirectoryTest, ImagesThatAreNotFilesOrDeclareHugeSizesAreSkippedUndecoded) {
