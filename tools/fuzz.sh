@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes the readers of untrusted input with libFuzzer (clang, ASan + UBSan): the .oni reader,
-# TUM folder lists, the mesh readers (PLY, OBJ, STL) and the config parser. Builds the targets
+# TUM folder lists and their PNG images, the mesh readers (PLY, OBJ, STL) and the config parser. Builds the targets
 # in build-fuzz, runs each for SECONDS from a small seed corpus and prints, per target, the
 # executions and the failing inputs — crashes, timeouts (20 s), out-of-memory (2 GiB) — kept under
 # build-fuzz/tools/fuzz/work/TARGET/crashes: make each one a test. Exit 1 when any input failed.
@@ -11,7 +11,7 @@ seconds="${1:-60}"
 [[ $# -gt 0 ]] && shift
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] &&
-  targets=(oni_reader_fuzzer tum_folder_fuzzer mesh_reader_fuzzer config_fuzzer)
+  targets=(oni_reader_fuzzer tum_folder_fuzzer png_decoder_fuzzer mesh_reader_fuzzer config_fuzzer)
 [[ "$seconds" =~ ^[0-9]+$ && "$seconds" -ge 1 ]] || {
   echo "fuzz: SECONDS must be a positive whole number, got '$seconds'" >&2
   exit 2
@@ -37,6 +37,22 @@ seed() {
     tum_folder_fuzzer)
       printf '# depth\n1.000000 depth/1.png\n1.033333 depth/2.png\n\0001.000100 rgb/1.png\n1.033400 rgb/2.png\n' >"$corpus/lists"
       printf '1.0 depth/1.png\n\0001.0 rgb/1.png\n\0001.0 rgb/1.png 1.0 depth/1.png\n' >"$corpus/associations" ;;
+    png_decoder_fuzzer)
+      # A 16-bit grey depth PNG and an 8-bit RGB one, 8x6 pixels (first byte: depth or colour).
+      python3 - "$corpus" <<'PY'
+import struct, sys, zlib
+def png(width, height, bit_depth, colour_type, row):
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    header = struct.pack(">IIBBBBB", width, height, bit_depth, colour_type, 0, 0, 0)
+    raw = b"".join(b"\0" + row(y) for y in range(height))
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+depth = png(8, 6, 16, 0, lambda y: b"".join(struct.pack(">H", 500 + 7 * x + y) for x in range(8)))
+colour = png(8, 6, 8, 2, lambda y: bytes((30 * x, 40 * y, 200) [c] for x in range(8) for c in range(3)))
+open(sys.argv[1] + "/depth", "wb").write(b"\1" + depth)
+open(sys.argv[1] + "/colour", "wb").write(b"\0" + colour)
+PY
+      ;;
     mesh_reader_fuzzer)
       printf '\000ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$corpus/ply"
       printf '\001v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$corpus/obj"
