@@ -17,7 +17,7 @@ void LoopingSource::Start() {
   round_ = 0;
   delivered_ = 0;
   offset_us_ = 0;
-  round_first_us_.reset();
+  round_starts_ = true;
   last_us_.reset();
   missed_before_ = skipped_before_ = 0;
 }
@@ -42,19 +42,18 @@ SourceRead LoopingSource::Next(std::chrono::milliseconds timeout) {
     inner_->Stop();
     inner_->Start();
     ++round_;
-    round_first_us_.reset();
+    round_starts_ = true;
     read = inner_->Next(timeout);
   }
   if (read.status != SourceStatus::kFrame) return read;
   const std::int64_t recorded = read.frame->depth_timestamp_us;
-  if (!round_first_us_) {
-    round_first_us_ = recorded;
+  if (round_starts_) {
     if (last_us_) offset_us_ = *last_us_ + interval_us_ - recorded;
+    round_starts_ = false;
+  } else if (last_us_ && recorded + offset_us_ > *last_us_) {
+    interval_us_ = recorded + offset_us_ - *last_us_;  // The recording's own frame interval.
   }
   const std::int64_t timestamp = recorded + offset_us_;
-  if (last_us_ && timestamp > *last_us_ && round_first_us_ != recorded) {
-    interval_us_ = timestamp - *last_us_;
-  }
   last_us_ = timestamp;
   if (round_ > 0 || read.frame->index != delivered_) {
     auto frame = std::make_shared<Frame>(*read.frame);

@@ -36,9 +36,9 @@ class LoopingSource : public FrameSource {
   const int times_;
   int round_ = 0;
   std::int64_t delivered_ = 0;
-  // Added to a round's timestamps; the round's first timestamp; the last two delivered.
+  // Added to a round's timestamps; whether the next frame starts a round; the last delivered.
   std::int64_t offset_us_ = 0;
-  std::optional<std::int64_t> round_first_us_;
+  bool round_starts_ = true;
   std::optional<std::int64_t> last_us_;
   std::int64_t interval_us_ = 33'333;
   std::int64_t missed_before_ = 0;

@@ -122,12 +122,9 @@ class PipelineFaultTest : public PipelineTestBase {
   // self-initialised scan is PipelineTest's.
   static const tracker::HandPose& FirstHand() {
     static const tracker::HandPose pose = [] {
-      auto source = Open(Oni());
-      source->Start();
-      const HandStage stage(Options(), source->Intrinsics());
       const auto joints =
           tracker::ReadHandJointsCsv(Oni().parent_path() / "gt" / "hand_joints.csv");
-      return tracker::FitPoseToJoints(stage.model(), joints.at(0).joints_mm);
+      return tracker::FitPoseToJoints(LoadHandTemplate(Options().scan), joints.at(0).joints_mm);
     }();
     return pose;
   }

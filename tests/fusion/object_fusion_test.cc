@@ -209,7 +209,7 @@ TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   const Frame first = test::RenderEllipsoid(kIntrinsics, Truth(0), axes);
   std::vector<std::uint8_t> mask(first.depth_mm.size());
   for (size_t p = 0; p < mask.size(); ++p) mask[p] = first.depth_mm[p] != 0;
-  EXPECT_EQ(fusion.Fuse({&first, &mask, {}, {}}).status, FusionStatus::kStarted);
+  EXPECT_EQ(fusion.Fuse({&first, &mask, {}}).status, FusionStatus::kStarted);
   // Contacts that claim the object jumped 80 mm: not integrated.
   FusionInput jump{&first, &mask, {}};
   for (int k = 0; k < 5; ++k) {
