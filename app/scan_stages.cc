@@ -1,9 +1,9 @@
 #include "app/scan_stages.h"
 
+#include "app/object_mask.h"
 #include "core/errors.h"
 #include "core/stopwatch.h"
 #include "fusion/correspondence_source.h"
-#include "fusion/object_mask.h"
 #include "fusion/shot_matcher.h"
 #include "fusion/sift_matcher.h"
 #include "tracker/contacts.h"
@@ -13,8 +13,13 @@
 namespace ihs::app {
 namespace {
 
-// The tracker's options with the template's scale estimate off when the scale is given or the
-// template is a scan of the user's own hand.
+const ScannerOptions& Checked(const ScannerOptions& options) {
+  options.Check();
+  return options;
+}
+
+}  // namespace
+
 tracker::TrackerOptions TrackerOptionsFor(const ScannerOptions& options) {
   tracker::TrackerOptions tracker_options = options.tracker;
   if (options.scan.hand_scale > 0 || options.scan.hand_template != "procedural") {
@@ -22,13 +27,6 @@ tracker::TrackerOptions TrackerOptionsFor(const ScannerOptions& options) {
   }
   return tracker_options;
 }
-
-const ScannerOptions& Checked(const ScannerOptions& options) {
-  options.Check();
-  return options;
-}
-
-}  // namespace
 
 tracker::HandModel LoadHandTemplate(const ScanOptions& options) {
   tracker::HandModel model = tracker::LoadHandTemplate(options.hand_template, !options.left_hand);
@@ -87,8 +85,8 @@ void HandStage::Process(FramePacket& packet) {
           tracker_.model().Pose(tracker::ForwardKinematics(tracker_.model(), packet.track.pose)));
     }
     packet.hand_pixels_removed =
-        fusion::RemoveMeshPixels(*hand, frame, intrinsics_, options_.hand_dilation_px,
-                                 options_.hand_depth_margin_mm, &packet.object_mask);
+        RemoveMeshPixels(*hand, frame, intrinsics_, options_.hand_dilation_px,
+                         options_.hand_depth_margin_mm, &packet.object_mask);
     packet.hand_mesh = std::move(hand);
     packet.fingertips = fingertips_;
   }

@@ -64,6 +64,10 @@ struct FramePacket {
 /// Throws ihs::InputError when a scanned model cannot be read.
 tracker::HandModel LoadHandTemplate(const ScanOptions& options);
 
+/// The tracker's options with the template's scale estimate off (scale_frames = 0) when the
+/// scale is given or the template is a scan of the user's own hand.
+tracker::TrackerOptions TrackerOptionsFor(const ScannerOptions& options);
+
 /// Hand tracking and the hand-free object mask.
 class HandStage {
  public:

@@ -36,9 +36,122 @@ void ScannerOptions::Check() const {
                 "fusion.pairwise.contact_weight must be > 0 when no visual features are on");
 }
 
-OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
-  OptionRegistry r;
-  ScanOptions& scan = options->scan;
+namespace {
+
+// The tracker's sub-groups: segmentation, the hand fit, the contacts.
+void AddSegmentationOptions(OptionRegistry& r, tracker::SegmentationOptions* segmentation) {
+  tracker::SegmentationOptions& s = *segmentation;
+  r.Add("tracker.segmentation.crop_min_mm", &s.crop_min_mm,
+        "crop volume's lower corner, camera frame, mm (paper: -100,-140,400)");
+  r.Add("tracker.segmentation.crop_max_mm", &s.crop_max_mm,
+        "crop volume's upper corner, camera frame, mm (paper: 100,220,1000)");
+  r.Add("tracker.segmentation.skin_log_ratio", &s.skin_log_ratio,
+        "skin when log p(rgb|skin) - log p(rgb|non-skin) exceeds this");
+  r.Add("tracker.segmentation.connect_depth_mm", &s.connect_depth_mm,
+        "neighbouring pixels join one region when their depths differ by at most this, mm");
+  r.Add("tracker.segmentation.min_region_pixels", &s.min_region_pixels,
+        "regions smaller than this many pixels are dropped");
+  r.Add("tracker.segmentation.connect_gap_px", &s.connect_gap_px,
+        "pixels also join a region across this many pixels without depth (0: neighbours only)");
+  r.Add("tracker.segmentation.boundary_px", &s.boundary_px,
+        "object pixels this close to the hand are left out");
+  r.Add("tracker.segmentation.max_object_distance_mm", &s.max_object_distance_mm,
+        "object regions farther than this from the hand's centre are left out, mm");
+  r.Add("tracker.segmentation.object_margin_mm", &s.object_margin_mm,
+        "an object region reaching into the crop volume goes on this far beyond it, mm");
+}
+
+void AddHandFitOptions(OptionRegistry& r, tracker::HandFitOptions* fit) {
+  tracker::HandFitOptions& f = *fit;
+  r.Add("tracker.fit.collision_weight", &f.collision_weight,
+        "gamma_c, weight of the finger collision term (paper: 10)");
+  r.Add("tracker.fit.outer_iterations", &f.outer_iterations, "correspondence updates per frame");
+  r.Add("tracker.fit.inner_iterations", &f.inner_iterations,
+        "Levenberg-Marquardt iterations per correspondence update");
+  r.Add("tracker.fit.max_data_points", &f.max_data_points, "data points matched to the model");
+  r.Add("tracker.fit.data_voxel_mm", &f.data_voxel_mm,
+        "data points: centroids of the hand points in cubes of this size, mm (0: a stride)");
+  r.Add("tracker.fit.max_model_points", &f.max_model_points,
+        "visible model points matched to the data");
+  r.Add("tracker.fit.max_correspondence_mm", &f.max_correspondence_mm,
+        "pairs farther apart are dropped, mm");
+  r.Add("tracker.fit.robust_scale_mm", &f.robust_scale_mm,
+        "pairs farther apart count with a Huber weight, mm");
+  r.Add("tracker.fit.limit_weight", &f.limit_weight, "weight of the soft joint limits, per rad");
+  r.Add("tracker.fit.prior_weight", &f.prior_weight,
+        "pull toward the predicted joint angles, per rad");
+  r.Add("tracker.fit.data_point_weight", &f.data_point_weight,
+        "weight of point-to-point data-to-model pairs besides point-to-plane");
+  r.Add("tracker.fit.silhouette_weight", &f.silhouette_weight, "weight of the silhouette term");
+  r.Add("tracker.fit.silhouette_tolerance_px", &f.silhouette_tolerance_px,
+        "model points this close to the silhouette count as inside, px");
+  r.Add("tracker.fit.unlabelled_match_mm", &f.unlabelled_match_mm,
+        "a seen model point is paired with an unsegmented depth pixel this near, mm (0: never)");
+  r.Add("tracker.fit.initial_trust_radius", &f.initial_trust_radius,
+        "initial Levenberg-Marquardt trust region");
+}
+
+void AddContactOptions(OptionRegistry& r, tracker::ContactOptions* contacts) {
+  tracker::ContactOptions& c = *contacts;
+  r.Add("tracker.contacts.start_mm", &c.start_mm,
+        "first fingertip-to-object distance threshold, mm (paper: 1)");
+  r.Add("tracker.contacts.step_mm", &c.step_mm, "threshold growth per retry, mm (paper: 0.5)");
+  r.Add("tracker.contacts.max_mm", &c.max_mm, "largest threshold, mm");
+  r.Add("tracker.contacts.min_vertices", &c.min_vertices,
+        "vertices within the threshold that make a contact bone (paper: 40)");
+  r.Add("tracker.contacts.reference_fingertip_vertices", &c.reference_fingertip_vertices,
+        "fingertip vertex count min_vertices refers to (other templates scale it)");
+  r.Add("tracker.contacts.min_bones", &c.min_bones, "contact bones wanted (paper: 2)");
+}
+
+// The fusion's sub-groups: the TSDF volume, and the registration (pairwise and ICP).
+void AddTsdfOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
+  fusion::FusionOptions& u = *fusion;
+  r.Add("fusion.tsdf.size_mm", &u.tsdf.size_mm, "edge of the TSDF cube, mm (paper: 350)");
+  r.Add("fusion.tsdf.resolution", &u.tsdf.resolution, "TSDF voxels per edge (paper: 256)");
+  r.Add("fusion.tsdf.truncation_voxels", &u.tsdf.truncation_voxels,
+        "signed distances truncated to this many voxels");
+  r.Add("fusion.tsdf.max_weight", &u.tsdf.max_weight, "cap of a voxel's integration weight");
+  r.Add("fusion.tsdf.color", &u.tsdf.color, "voxels keep a colour");
+}
+
+void AddRegistrationOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
+  fusion::FusionOptions& u = *fusion;
+  r.Add("fusion.pairwise.contact_weight", &u.pairwise.contact_weight,
+        "gamma_t, weight of a contact pair against a visual pair (paper: 15; 0: visual only)");
+  r.Add("fusion.pairwise.visual_weight", &u.pairwise.visual_weight,
+        "weight of visual pairs (0: contacts only)");
+  r.Add("fusion.pairwise.check_contacts", &u.pairwise.check_contacts,
+        "drop contacts that a consistent set of visual matches contradicts");
+  r.Add("fusion.pairwise.ransac_iterations", &u.pairwise.ransac_iterations,
+        "RANSAC hypotheses over the visual pairs");
+  r.Add("fusion.pairwise.inlier_mm", &u.pairwise.inlier_mm, "RANSAC inlier distance, mm");
+  r.Add("fusion.pairwise.min_visual_inliers", &u.pairwise.min_visual_inliers,
+        "inliers a visual set needs to count");
+  r.Add("fusion.pairwise.min_contacts", &u.pairwise.min_contacts,
+        "contact pairs needed when they are all there is");
+  r.Add("fusion.pairwise.min_contact_spread_mm", &u.pairwise.min_contact_spread_mm,
+        "contacts count only when spread at least this far (two fingertips), mm");
+  r.Add("fusion.pairwise.visual_turn_prior_deg", &u.pairwise.visual_turn_prior_deg,
+        "visual matches alone: their turn shrinks toward none under this prior per frame, "
+        "degrees (0: kept)");
+  r.Add("fusion.pairwise.seed", &u.pairwise.seed, "seed of the RANSAC sampling");
+  r.Add("fusion.icp.iterations", &u.icp.iterations, "ICP Gauss-Newton iterations at most");
+  r.Add("fusion.icp.max_distance_mm", &u.icp.max_distance_mm,
+        "ICP pairs farther apart are not used, mm (paper: 5)");
+  r.Add("fusion.icp.min_inlier_fraction", &u.icp.min_inlier_fraction,
+        "ICP with fewer pairs than this share of points is not trusted");
+  r.Add("fusion.icp.anchor_share", &u.icp.anchor_share,
+        "share of the surface pairs' weight the contact anchors carry in ICP");
+  r.Add("fusion.icp.min_constraint_over_noise", &u.icp.min_constraint_over_noise,
+        "without anchors, ICP leaves directions the surface constrains less than this many times "
+        "its normals' noise at the prediction (0: solves all)");
+}
+
+}  // namespace
+
+void AddScanOptions(OptionRegistry& r, ScanOptions* options) {
+  ScanOptions& scan = *options;
   r.Add("scan.hand_template", &scan.hand_template,
         "hand template: procedural, or the folder of a scanned hand model");
   r.Add("scan.hand_scale", &scan.hand_scale,
@@ -55,8 +168,10 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("scan.features_2d", &scan.features_2d, "SIFT matches on the object's colour (E_feat2d)");
   r.Add("scan.features_3d", &scan.features_3d,
         "ISS3D + CSHOT matches (E_feat3d; slow, misleading on symmetric objects)");
+}
 
-  tracker::TrackerOptions& t = options->tracker;
+void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
+  tracker::TrackerOptions& t = *options;
   r.Add("tracker.min_hand_points", &t.min_hand_points, "hand points a frame needs to be fitted");
   r.Add("tracker.min_data_coverage", &t.min_data_coverage,
         "share of hand points within 10 mm of the model below which the fit has diverged");
@@ -85,77 +200,28 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "frames over which the template's scale is estimated (0: none)");
   r.Add("tracker.scale_range", &t.scale_range, "scale candidates span 1 ± this");
   r.Add("tracker.scale_step", &t.scale_step, "step between scale candidates");
-  tracker::SegmentationOptions& s = t.segmentation;
-  r.Add("tracker.segmentation.crop_min_mm", &s.crop_min_mm,
-        "crop volume's lower corner, camera frame, mm (paper: -100,-140,400)");
-  r.Add("tracker.segmentation.crop_max_mm", &s.crop_max_mm,
-        "crop volume's upper corner, camera frame, mm (paper: 100,220,1000)");
-  r.Add("tracker.segmentation.skin_log_ratio", &s.skin_log_ratio,
-        "skin when log p(rgb|skin) - log p(rgb|non-skin) exceeds this");
-  r.Add("tracker.segmentation.connect_depth_mm", &s.connect_depth_mm,
-        "neighbouring pixels join one region when their depths differ by at most this, mm");
-  r.Add("tracker.segmentation.min_region_pixels", &s.min_region_pixels,
-        "regions smaller than this many pixels are dropped");
-  r.Add("tracker.segmentation.connect_gap_px", &s.connect_gap_px,
-        "pixels also join a region across this many pixels without depth (0: neighbours only)");
-  r.Add("tracker.segmentation.boundary_px", &s.boundary_px,
-        "object pixels this close to the hand are left out");
-  r.Add("tracker.segmentation.max_object_distance_mm", &s.max_object_distance_mm,
-        "object regions farther than this from the hand's centre are left out, mm");
-  r.Add("tracker.segmentation.object_margin_mm", &s.object_margin_mm,
-        "an object region reaching into the crop volume goes on this far beyond it, mm");
-  tracker::HandFitOptions& f = t.fit;
-  r.Add("tracker.fit.collision_weight", &f.collision_weight,
-        "gamma_c, weight of the finger collision term (paper: 10)");
-  r.Add("tracker.fit.outer_iterations", &f.outer_iterations, "correspondence updates per frame");
-  r.Add("tracker.fit.inner_iterations", &f.inner_iterations,
-        "Levenberg-Marquardt iterations per correspondence update");
-  r.Add("tracker.fit.max_data_points", &f.max_data_points, "data points matched to the model");
-  r.Add("tracker.fit.data_voxel_mm", &f.data_voxel_mm,
-        "data points: centroids of the hand points in cubes of this size, mm (0: a stride)");
-  r.Add("tracker.fit.max_model_points", &f.max_model_points,
-        "visible model points matched to the data");
-  r.Add("tracker.fit.max_correspondence_mm", &f.max_correspondence_mm,
-        "pairs farther apart are dropped, mm");
-  r.Add("tracker.fit.robust_scale_mm", &f.robust_scale_mm,
-        "pairs farther apart count with a Huber weight, mm");
-  r.Add("tracker.fit.limit_weight", &f.limit_weight, "weight of the soft joint limits, per rad");
-  r.Add("tracker.fit.prior_weight", &f.prior_weight,
-        "pull toward the predicted joint angles, per rad");
-  r.Add("tracker.fit.data_point_weight", &f.data_point_weight,
-        "weight of point-to-point data-to-model pairs besides point-to-plane");
-  r.Add("tracker.fit.silhouette_weight", &f.silhouette_weight, "weight of the silhouette term");
-  r.Add("tracker.fit.silhouette_tolerance_px", &f.silhouette_tolerance_px,
-        "model points this close to the silhouette count as inside, px");
-  r.Add("tracker.fit.unlabelled_match_mm", &f.unlabelled_match_mm,
-        "a seen model point is paired with an unsegmented depth pixel this near, mm (0: never)");
-  r.Add("tracker.fit.initial_trust_radius", &f.initial_trust_radius,
-        "initial Levenberg-Marquardt trust region");
-  tracker::ContactOptions& c = t.contacts;
-  r.Add("tracker.contacts.start_mm", &c.start_mm,
-        "first fingertip-to-object distance threshold, mm (paper: 1)");
-  r.Add("tracker.contacts.step_mm", &c.step_mm, "threshold growth per retry, mm (paper: 0.5)");
-  r.Add("tracker.contacts.max_mm", &c.max_mm, "largest threshold, mm");
-  r.Add("tracker.contacts.min_vertices", &c.min_vertices,
-        "vertices within the threshold that make a contact bone (paper: 40)");
-  r.Add("tracker.contacts.reference_fingertip_vertices", &c.reference_fingertip_vertices,
-        "fingertip vertex count min_vertices refers to (other templates scale it)");
-  r.Add("tracker.contacts.min_bones", &c.min_bones, "contact bones wanted (paper: 2)");
+  AddSegmentationOptions(r, &t.segmentation);
+  AddHandFitOptions(r, &t.fit);
+  AddContactOptions(r, &t.contacts);
+}
 
-  r.Add("features.sift.max_features", &options->sift.max_features, "SIFT keypoints per frame");
-  r.Add("features.sift.ratio", &options->sift.ratio, "Lowe's ratio test for SIFT matches");
-  fusion::ShotOptions& shot = options->shot;
-  r.Add("features.shot.resolution_mm", &shot.resolution_mm,
+void AddFeatureOptions(OptionRegistry& r, fusion::SiftOptions* sift, fusion::ShotOptions* shot) {
+  r.Add("features.sift.max_features", &sift->max_features, "SIFT keypoints per frame");
+  r.Add("features.sift.ratio", &sift->ratio, "Lowe's ratio test for SIFT matches");
+  r.Add("features.shot.resolution_mm", &shot->resolution_mm,
         "voxel size of the cloud ISS3D + CSHOT work on, mm");
-  r.Add("features.shot.normal_radius", &shot.normal_radius, "normal radius, in resolutions");
-  r.Add("features.shot.salient_radius", &shot.salient_radius, "ISS salient radius, in resolutions");
-  r.Add("features.shot.non_max_radius", &shot.non_max_radius,
+  r.Add("features.shot.normal_radius", &shot->normal_radius, "normal radius, in resolutions");
+  r.Add("features.shot.salient_radius", &shot->salient_radius,
+        "ISS salient radius, in resolutions");
+  r.Add("features.shot.non_max_radius", &shot->non_max_radius,
         "ISS non-maximum suppression radius, in resolutions");
-  r.Add("features.shot.support_radius", &shot.support_radius,
+  r.Add("features.shot.support_radius", &shot->support_radius,
         "CSHOT support radius, in resolutions");
-  r.Add("features.shot.ratio", &shot.ratio, "ratio test for CSHOT matches");
+  r.Add("features.shot.ratio", &shot->ratio, "ratio test for CSHOT matches");
+}
 
-  fusion::FusionOptions& u = options->fusion;
+void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
+  fusion::FusionOptions& u = *options;
   r.Add("fusion.use_icp", &u.use_icp, "refine with point-to-plane ICP against the model");
   r.Add("fusion.icp_retry_fraction", &u.icp_retry_fraction,
         "ICP is retried from the previous pose when it pairs fewer than this share of points");
@@ -197,43 +263,12 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
         "views that must see through a point for it to be empty");
   r.Add("fusion.free_space.no_depth_is_empty", &u.free_space.no_depth_is_empty,
         "pixels without depth far from any with depth are rays that met nothing");
-  r.Add("fusion.tsdf.size_mm", &u.tsdf.size_mm, "edge of the TSDF cube, mm (paper: 350)");
-  r.Add("fusion.tsdf.resolution", &u.tsdf.resolution, "TSDF voxels per edge (paper: 256)");
-  r.Add("fusion.tsdf.truncation_voxels", &u.tsdf.truncation_voxels,
-        "signed distances truncated to this many voxels");
-  r.Add("fusion.tsdf.max_weight", &u.tsdf.max_weight, "cap of a voxel's integration weight");
-  r.Add("fusion.tsdf.color", &u.tsdf.color, "voxels keep a colour");
-  r.Add("fusion.pairwise.contact_weight", &u.pairwise.contact_weight,
-        "gamma_t, weight of a contact pair against a visual pair (paper: 15; 0: visual only)");
-  r.Add("fusion.pairwise.visual_weight", &u.pairwise.visual_weight,
-        "weight of visual pairs (0: contacts only)");
-  r.Add("fusion.pairwise.check_contacts", &u.pairwise.check_contacts,
-        "drop contacts that a consistent set of visual matches contradicts");
-  r.Add("fusion.pairwise.ransac_iterations", &u.pairwise.ransac_iterations,
-        "RANSAC hypotheses over the visual pairs");
-  r.Add("fusion.pairwise.inlier_mm", &u.pairwise.inlier_mm, "RANSAC inlier distance, mm");
-  r.Add("fusion.pairwise.min_visual_inliers", &u.pairwise.min_visual_inliers,
-        "inliers a visual set needs to count");
-  r.Add("fusion.pairwise.min_contacts", &u.pairwise.min_contacts,
-        "contact pairs needed when they are all there is");
-  r.Add("fusion.pairwise.min_contact_spread_mm", &u.pairwise.min_contact_spread_mm,
-        "contacts count only when spread at least this far (two fingertips), mm");
-  r.Add("fusion.pairwise.visual_turn_prior_deg", &u.pairwise.visual_turn_prior_deg,
-        "visual matches alone: their turn shrinks toward none under this prior per frame, "
-        "degrees (0: kept)");
-  r.Add("fusion.pairwise.seed", &u.pairwise.seed, "seed of the RANSAC sampling");
-  r.Add("fusion.icp.iterations", &u.icp.iterations, "ICP Gauss-Newton iterations at most");
-  r.Add("fusion.icp.max_distance_mm", &u.icp.max_distance_mm,
-        "ICP pairs farther apart are not used, mm (paper: 5)");
-  r.Add("fusion.icp.min_inlier_fraction", &u.icp.min_inlier_fraction,
-        "ICP with fewer pairs than this share of points is not trusted");
-  r.Add("fusion.icp.anchor_share", &u.icp.anchor_share,
-        "share of the surface pairs' weight the contact anchors carry in ICP");
-  r.Add("fusion.icp.min_constraint_over_noise", &u.icp.min_constraint_over_noise,
-        "without anchors, ICP leaves directions the surface constrains less than this many times "
-        "its normals' noise at the prediction (0: solves all)");
+  AddTsdfOptions(r, options);
+  AddRegistrationOptions(r, options);
+}
 
-  fusion::MeshingOptions& m = options->meshing;
+void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
+  fusion::MeshingOptions& m = *options;
   r.Add("mesh.min_component_fraction", &m.min_component_fraction,
         "pieces smaller than this share of the largest are dropped");
   r.Add("mesh.smoothing_iterations", &m.smoothing_iterations, "HC Laplacian iterations (0: none)");
@@ -249,8 +284,10 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("mesh.bound_keep_seen_mm", &m.bound_keep_seen_mm,
         "nothing within this of the seen surface is cut, mm");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
+}
 
-  PipelineOptions& p = options->pipeline;
+void AddPipelineOptions(OptionRegistry& r, PipelineOptions* options) {
+  PipelineOptions& p = *options;
   r.Add("pipeline.queue_capacity", &p.queue_capacity, "frames each queue between threads holds");
   r.Add("pipeline.preview_every", &p.preview_every,
         "write a preview image every this many fused frames (0: never)");
@@ -258,6 +295,16 @@ OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
   r.Add("pipeline.stop_grace_s", &p.stop_grace_s,
         "seconds the frames in hand get after a stop before a stage still busy is left behind "
         "and the model so far is exported without them (exit 5)");
+}
+
+OptionRegistry RegisterScannerOptions(ScannerOptions* options) {
+  OptionRegistry r;
+  AddScanOptions(r, &options->scan);
+  AddTrackerOptions(r, &options->tracker);
+  AddFeatureOptions(r, &options->sift, &options->shot);
+  AddFusionOptions(r, &options->fusion);
+  AddMeshingOptions(r, &options->meshing);
+  AddPipelineOptions(r, &options->pipeline);
   return r;
 }
 

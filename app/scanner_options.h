@@ -79,8 +79,19 @@ struct ScannerOptions {
   void Check() const;
 };
 
-/// Registers every field of `options` under its dotted name ("fusion.icp.max_distance_mm") with
-/// one line of meaning. The registry points into `options`, which must outlive it.
+/// The option groups (COLMAP's Add*Options style): each registers the fields of one stage's
+/// options under its dotted names ("fusion.icp.max_distance_mm") with one line of meaning; a tool
+/// adds the groups it uses, and names from other groups are unknown to it. The registry points
+/// into the structs, which must outlive it.
+void AddScanOptions(OptionRegistry& registry, ScanOptions* options);                 ///< scan.*
+void AddTrackerOptions(OptionRegistry& registry, tracker::TrackerOptions* options);  ///< tracker.*
+void AddFeatureOptions(OptionRegistry& registry, fusion::SiftOptions* sift,
+                       fusion::ShotOptions* shot);                                  ///< features.*
+void AddFusionOptions(OptionRegistry& registry, fusion::FusionOptions* options);    ///< fusion.*
+void AddMeshingOptions(OptionRegistry& registry, fusion::MeshingOptions* options);  ///< mesh.*
+void AddPipelineOptions(OptionRegistry& registry, PipelineOptions* options);        ///< pipeline.*
+
+/// Every group: all the options of `options` (inhandscan's and inhandscan-scan's).
 OptionRegistry RegisterScannerOptions(ScannerOptions* options);
 
 }  // namespace ihs::app

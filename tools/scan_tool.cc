@@ -22,15 +22,14 @@
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
 #include "app/scanner_options.h"
+#include "app/sequential_scan.h"
 #include "core/allocator.h"
 #include "core/command_line.h"
 #include "core/errors.h"
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "core/stopwatch.h"
-#include "sensor/open_input.h"
 #include "tools/evaluation.h"
-#include "tracker/hand_data.h"
 #include "tracker/hand_joints_io.h"
 
 namespace {
@@ -46,9 +45,8 @@ struct Args {
   std::vector<std::string> assignments;  // --set NAME=VALUE, applied after the flags above.
 };
 
-int Run(const Args& args) {
-  namespace tracker = ihs::tracker;
-  namespace fusion = ihs::fusion;
+// The scanner's options from the flags, then the --set assignments.
+ihs::app::ScannerOptions OptionsFrom(const Args& args) {
   ihs::app::ScannerOptions options;
   options.scan.hand_template = args.template_name;
   options.scan.hand_scale = args.hand_scale;
@@ -65,102 +63,71 @@ int Run(const Args& args) {
   ihs::app::OptionRegistry registry = ihs::app::RegisterScannerOptions(&options);
   for (const std::string& assignment : args.assignments) registry.SetAssignment(assignment);
   options.Check();
+  return options;
+}
 
-  std::vector<tracker::HandJointsRow> gt_joints;
-  std::string object = args.object;
-  if (!args.gt.empty()) {
-    gt_joints = tracker::ReadHandJointsCsv(fs::path(args.gt) / "hand_joints.csv");
-    if (object.empty()) {
-      std::ifstream manifest(fs::path(args.gt) / "manifest.json");
-      if (!manifest) throw ihs::InputError(args.gt + "/manifest.json: cannot read");
-      object = nlohmann::json::parse(manifest, nullptr, false)
-                   .value("object", nlohmann::json::object())
-                   .value("spec", "");
-    }
-  } else if (args.init_from_gt) {
-    throw std::invalid_argument("--init-from-gt needs --gt");
+// The sequential run's options: --frames, and the hand's first pose from the ground truth.
+ihs::app::SequentialOptions RunOptionsFrom(const Args& args) {
+  ihs::app::SequentialOptions run;
+  run.max_frames = args.max_frames;
+  if (args.init_from_gt) {
+    if (args.gt.empty()) throw std::invalid_argument("--init-from-gt needs --gt");
+    const auto gt_joints = ihs::tracker::ReadHandJointsCsv(fs::path(args.gt) / "hand_joints.csv");
+    if (gt_joints.empty()) throw ihs::InputError(args.gt + ": no ground-truth joints");
+    run.first_joints_mm = gt_joints.front().joints_mm;
   }
+  return run;
+}
 
-  auto source = ihs::sensor::OpenInput(args.input);
-  source->Start();
-  const ihs::CameraIntrinsics intrinsics = source->Intrinsics();
-  ihs::app::HandStage hand(options, intrinsics);
-  ihs::app::ObjectStage object_stage(options, intrinsics);
-  ihs::app::ScanRecord record(hand.BoneNames());
-  const fs::path out = args.out;
+// What was scanned: --object, or the ground truth manifest's object.
+std::string ObjectFrom(const Args& args) {
+  if (!args.object.empty() || args.gt.empty()) return args.object;
+  std::ifstream manifest(fs::path(args.gt) / "manifest.json");
+  if (!manifest) throw ihs::InputError(args.gt + "/manifest.json: cannot read");
+  return nlohmann::json::parse(manifest, nullptr, false)
+      .value("object", nlohmann::json::object())
+      .value("spec", "");
+}
+
+// The output folder, created, without an earlier scan's files.
+void PrepareOutput(const fs::path& out) {
   std::error_code error;
   fs::create_directories(out, error);
   if (error) throw ihs::OutputError(out.string() + ": cannot create (" + error.message() + ")");
   if (const int removed = ihs::app::RemovePreviousScan(out)) {
     spdlog::info("{}: removed {} files of an earlier scan", out.string(), removed);
   }
+}
 
-  std::int64_t index = 0;
-  std::vector<ihs::eval::FrameContactUse> contact_use;
-  const auto run_start = ihs::SteadyClock::now();
-  while (args.max_frames <= 0 || index < args.max_frames) {
-    const ihs::sensor::SourceRead read = source->Next(std::chrono::seconds(5));
-    if (read.status == ihs::sensor::SourceStatus::kTimeout) continue;
-    if (read.status != ihs::sensor::SourceStatus::kFrame) break;
-    if (index == 0 && args.init_from_gt) {
-      if (gt_joints.empty()) throw ihs::InputError(args.gt + ": no ground-truth joints");
-      hand.Initialise(tracker::FitPoseToJoints(hand.model(), gt_joints.front().joints_mm));
-    }
-    ihs::app::FramePacket packet;
-    packet.frame = read.frame;
-    hand.Process(packet);
-    object_stage.Process(packet);
-    record.Add(packet);
-    contact_use.push_back({packet.frame->depth_timestamp_us * 1e-6, packet.fusion.ContactsUsed()});
-    ++index;
-  }
-  if (index == 0) throw ihs::InputError(args.input + ": no frames");
-  const double run_s = ihs::MillisecondsSince(run_start) / 1000.0;
+// The meshes' export times and measures for stats.json.
+nlohmann::json MeshSummary(const ihs::fusion::MeshingResult& meshes, double export_ms,
+                           double marching_cubes_ms) {
+  return {{"export_ms",
+           {{"total", export_ms},
+            {"marching_cubes", marching_cubes_ms},
+            {"cleanup", meshes.cleanup_ms},
+            {"smoothing", meshes.smoothing_ms},
+            {"poisson", meshes.poisson_ms},
+            {"bound", meshes.bound_ms}}},
+          {"mesh",
+           {{"faces", meshes.watertight.faces.size()},
+            {"watertight", meshes.IsWatertight()},
+            {"self_intersections", meshes.self_intersections},
+            {"unseen_share", meshes.unseen_share},
+            {"cut_share", meshes.cut_share},
+            {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
+}
 
-  // Meshes.
-  auto start = ihs::SteadyClock::now();
-  const ihs::fusion::ModelSnapshot model = object_stage.Snapshot();
-  const double marching_cubes_ms = ihs::MillisecondsSince(start);
-  const ihs::app::ExportedMeshes exported = ihs::app::ExportMeshes(model, options.meshing, out);
-  const double export_ms = ihs::MillisecondsSince(start);
-  const fusion::MeshingResult& meshes = exported.meshes;
-  if (exported.files.empty()) {
-    // As `inhandscan replay` ends it: code 5 and the skip reasons.
-    std::fprintf(stderr, "inhandscan-scan: error: %s: %s\n", args.input.c_str(),
-                 record.NothingScanned().c_str());
-    return ihs::kExitStageFailed;
-  }
-  record.WriteTables(out);
-
-  nlohmann::json summary = record.Summary();
-  nlohmann::json extra = {
-      {"hand_scale", hand.scale()},
-      {"hand_scale_at_bound", hand.scale_at_bound()},
-      {"gamma_t", args.gamma_t},
-      {"icp", !args.no_icp},
-      {"visual", !args.contacts_only},
-      {"seconds", run_s},
-      {"export_ms",
-       {{"total", export_ms},
-        {"marching_cubes", marching_cubes_ms},
-        {"cleanup", meshes.cleanup_ms},
-        {"smoothing", meshes.smoothing_ms},
-        {"poisson", meshes.poisson_ms},
-        {"bound", meshes.bound_ms}}},
-      {"mesh",
-       {{"faces", meshes.watertight.faces.size()},
-        {"watertight", meshes.IsWatertight()},
-        {"self_intersections", meshes.self_intersections},
-        {"unseen_share", meshes.unseen_share},
-        {"cut_share", meshes.cut_share},
-        {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
-
+// The run's lines on stdout: frames, time per stage, export, mesh and coverage.
+void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
+                  const nlohmann::json& summary, const ihs::fusion::MeshingResult& meshes,
+                  double export_ms, double marching_cubes_ms, const fs::path& out) {
   auto count = [](const nlohmann::json& counts, const char* key) {
     return counts.contains(key) ? counts[key].get<int>() : 0;
   };
   const auto& fusion_counts = summary["fusion_status_counts"];
   std::printf("frames %lld: registered %lld (started %d, fused %d, skipped %d)\n",
-              static_cast<long long>(index), static_cast<long long>(record.registered()),
+              static_cast<long long>(frames), static_cast<long long>(record.registered()),
               count(fusion_counts, "started"), count(fusion_counts, "fused"),
               count(fusion_counts, "skipped"));
   for (const auto& [reason, n] : record.skip_reasons())
@@ -189,26 +156,76 @@ int Run(const Args& args) {
     std::printf("closure: %.1f %% of Poisson's volume cut away where the views saw empty space\n",
                 100 * meshes.cut_share);
   }
+}
 
+// The scan against the ground truth (printed; returned for stats.json): the paper's measures
+// and the surface's distances, and how the contacts were used where the truth grasps.
+nlohmann::json Evaluate(const Args& args, const std::string& object,
+                        const ihs::app::ScanRecord& record,
+                        const ihs::fusion::MeshingResult& meshes,
+                        const std::vector<ihs::eval::FrameContactUse>& contact_use) {
+  // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's
+  // closing of what was never seen (a base under the hand) is guesswork that would add to a
+  // bottle's height. The volume needs the watertight mesh.
+  nlohmann::json evaluation =
+      ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed, meshes.watertight,
+                            args.gt, record.trajectory(), meshes.unseen_share);
+  const ihs::eval::ContactUse use = ihs::eval::CompareContactUse(args.gt, contact_use);
+  std::printf(
+      "contacts used in %d of %d frames where the truth grasps (%.0f %%); %d of %d frames with "
+      "contacts used had no fingertip within 3 mm (%.0f %%)\n",
+      use.used_in_grasp, use.grasp_frames, 100 * use.recall, use.false_frames, use.used_frames,
+      100 * use.false_share);
+  evaluation["contacts"] = {{"grasp_frames", use.grasp_frames},
+                            {"used_in_grasp", use.used_in_grasp},
+                            {"recall", use.recall},
+                            {"used_frames", use.used_frames},
+                            {"false_frames", use.false_frames},
+                            {"false_share", use.false_share}};
+  return evaluation;
+}
+
+int Run(const Args& args) {
+  const ihs::app::ScannerOptions options = OptionsFrom(args);
+  const std::string object = ObjectFrom(args);
+  ihs::app::SequentialScan scan(args.input, RunOptionsFrom(args));
+  ihs::app::HandStage hand(options, scan.intrinsics());
+  ihs::app::ObjectStage object_stage(options, scan.intrinsics());
+  ihs::app::ScanRecord record(hand.BoneNames());
+  const fs::path out = args.out;
+  PrepareOutput(out);
+
+  std::vector<ihs::eval::FrameContactUse> contact_use;
+  const auto run_start = ihs::SteadyClock::now();
+  const std::int64_t frames = scan.Run(hand, [&](ihs::app::FramePacket& packet) {
+    ihs::app::ScanObject(object_stage, record, packet);
+    contact_use.push_back({packet.frame->depth_timestamp_us * 1e-6, packet.fusion.ContactsUsed()});
+  });
+  const double run_s = ihs::MillisecondsSince(run_start) / 1000.0;
+
+  // Meshes.
+  auto start = ihs::SteadyClock::now();
+  const ihs::fusion::ModelSnapshot model = object_stage.Snapshot();
+  const double marching_cubes_ms = ihs::MillisecondsSince(start);
+  const ihs::app::ExportedMeshes exported = ihs::app::ExportMeshes(model, options.meshing, out);
+  const double export_ms = ihs::MillisecondsSince(start);
+  if (exported.files.empty()) {
+    // As `inhandscan replay` ends it: code 5 and the skip reasons.
+    std::fprintf(stderr, "inhandscan-scan: error: %s: %s\n", args.input.c_str(),
+                 record.NothingScanned().c_str());
+    return ihs::kExitStageFailed;
+  }
+  record.WriteTables(out);
+
+  const nlohmann::json summary = record.Summary();
+  nlohmann::json extra = {
+      {"hand_scale", hand.scale()},    {"hand_scale_at_bound", hand.scale_at_bound()},
+      {"gamma_t", args.gamma_t},       {"icp", !args.no_icp},
+      {"visual", !args.contacts_only}, {"seconds", run_s}};
+  extra.update(MeshSummary(exported.meshes, export_ms, marching_cubes_ms));
+  PrintSummary(frames, record, summary, exported.meshes, export_ms, marching_cubes_ms, out);
   if (!args.gt.empty()) {
-    // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's
-    // closing of what was never seen (a base under the hand) is guesswork that would add to a
-    // bottle's height. The volume needs the watertight mesh.
-    extra["evaluation"] =
-        ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed, meshes.watertight,
-                              args.gt, record.trajectory(), meshes.unseen_share);
-    const ihs::eval::ContactUse use = ihs::eval::CompareContactUse(args.gt, contact_use);
-    std::printf(
-        "contacts used in %d of %d frames where the truth grasps (%.0f %%); %d of %d frames with "
-        "contacts used had no fingertip within 3 mm (%.0f %%)\n",
-        use.used_in_grasp, use.grasp_frames, 100 * use.recall, use.false_frames, use.used_frames,
-        100 * use.false_share);
-    extra["evaluation"]["contacts"] = {{"grasp_frames", use.grasp_frames},
-                                       {"used_in_grasp", use.used_in_grasp},
-                                       {"recall", use.recall},
-                                       {"used_frames", use.used_frames},
-                                       {"false_frames", use.false_frames},
-                                       {"false_share", use.false_share}};
+    extra["evaluation"] = Evaluate(args, object, record, exported.meshes, contact_use);
   }
   record.WriteStats(out / "stats.json", extra);
   return ihs::kExitOk;

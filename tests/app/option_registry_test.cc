@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include <cctype>
+#include <functional>
 
 #include "app/scanner_options.h"
 #include "core/errors.h"
@@ -123,6 +124,35 @@ TEST(OptionRegistryTest, TheScannersOptionsRoundTripThroughTheirDescription) {
   EXPECT_EQ(defaults.fusion.tsdf.resolution, 256);
   EXPECT_EQ(defaults.meshing.poisson_depth, 10);
   EXPECT_NO_THROW(defaults.Check());
+}
+
+// Each group registers its own prefix; all groups together are the scanner's options, in order.
+TEST(OptionRegistryTest, EachGroupHoldsItsPrefixAndTheGroupsMakeTheWhole) {
+  ScannerOptions options;
+  const std::vector<std::pair<std::string, std::function<void(OptionRegistry&)>>> groups = {
+      {"scan.", [&](OptionRegistry& r) { AddScanOptions(r, &options.scan); }},
+      {"tracker.", [&](OptionRegistry& r) { AddTrackerOptions(r, &options.tracker); }},
+      {"features.", [&](OptionRegistry& r) { AddFeatureOptions(r, &options.sift, &options.shot); }},
+      {"fusion.", [&](OptionRegistry& r) { AddFusionOptions(r, &options.fusion); }},
+      {"mesh.", [&](OptionRegistry& r) { AddMeshingOptions(r, &options.meshing); }},
+      {"pipeline.", [&](OptionRegistry& r) { AddPipelineOptions(r, &options.pipeline); }}};
+  std::vector<std::string> all;
+  for (const auto& [prefix, add] : groups) {
+    OptionRegistry group;
+    add(group);
+    EXPECT_FALSE(group.Names().empty()) << prefix;
+    for (const std::string& name : group.Names()) {
+      EXPECT_EQ(name.rfind(prefix, 0), 0u) << name << " in the group " << prefix;
+      all.push_back(name);
+    }
+  }
+  EXPECT_EQ(all, RegisterScannerOptions(&options).Names());
+  // A tool that adds only the tracker's group does not know the others' names.
+  OptionRegistry tracker_only;
+  AddTrackerOptions(tracker_only, &options.tracker);
+  EXPECT_NO_THROW(tracker_only.Set("tracker.contacts.max_mm", "8"));
+  EXPECT_EQ(options.tracker.contacts.max_mm, 8.0);
+  EXPECT_THROW(tracker_only.Set("fusion.icp.iterations", "3"), std::invalid_argument);
 }
 
 TEST(OptionRegistryTest, ScannerOptionsCheckNamesTheBadField) {

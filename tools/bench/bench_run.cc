@@ -9,11 +9,11 @@
 
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
+#include "app/sequential_scan.h"
 #include "core/errors.h"
 #include "core/stopwatch.h"
 #include "fusion/surface_mesh.h"
 #include "render/offscreen_renderer.h"
-#include "sensor/open_input.h"
 #include "tools/bench/open3d_baseline.h"
 #include "tools/evaluation.h"
 #include "tools/synth/sequence.h"
@@ -128,6 +128,138 @@ void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const fusion::Mo
   result.watertight = std::move(meshes.watertight);
 }
 
+// The pixels the truth labels as the object (gt/labels/<index>.png), for Open3D's baseline;
+// none when the labels are missing.
+std::vector<std::uint8_t> TruthObjectPixels(const fs::path& gt_dir, const Frame& frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(frame.index));
+  const cv::Mat labels = cv::imread((gt_dir / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
+  std::vector<std::uint8_t> keep(frame.PixelCount(), 0);
+  if (labels.total() == keep.size() && labels.isContinuous()) {
+    for (size_t i = 0; i < keep.size(); ++i) keep[i] = labels.data[i] == render::kObject;
+  }
+  return keep;
+}
+
+}  // namespace
+
+namespace {
+
+// The frames' pass: the hand tracked once, each method's stage and record on a copy of the
+// packet, Open3D's baseline on the frame with the truth's object pixels.
+void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& hand,
+                const std::vector<tracker::HandJointsRow>& gt_joints, std::vector<Runner>& runners,
+                Open3dBaseline* open3d, bool quiet, CaseResult& out) {
+  double joint_error_sum = 0, track_ms = 0, mask_ms = 0;
+  int frames = 0;
+  scan.Run(hand, [&](app::FramePacket& packet) {
+    track_ms += packet.track.milliseconds;
+    mask_ms += packet.mask_ms;
+    const std::int64_t index = packet.frame->index;
+    if (!packet.track.joints_mm.empty() && index < static_cast<std::int64_t>(gt_joints.size())) {
+      joint_error_sum +=
+          tracker::MeanJointError(packet.track.joints_mm, gt_joints[index].joints_mm);
+      ++out.tracked_frames;
+    }
+    for (Runner& runner : runners) {
+      app::FramePacket copy = packet;
+      app::ScanObject(*runner.stage, *runner.record, copy);
+    }
+    if (open3d) open3d->Process(*packet.frame, TruthObjectPixels(out.gt_dir, *packet.frame));
+    ++frames;
+    if (!quiet && frames % 200 == 0)
+      std::fprintf(stderr, "inhandscan-bench: %s frame %d\n", c.name.c_str(), frames);
+  });
+  out.joint_error_mm = out.tracked_frames ? joint_error_sum / out.tracked_frames : 0;
+  out.track_ms = track_ms / frames;
+  out.mask_ms = mask_ms / frames;
+  out.frames = frames;
+}
+
+// One method's result from its stage and record: its log beside the sequence, then its
+// measures (the sweep's from the trajectory alone, the others' from the meshes too).
+MethodResult FinishMethod(const BenchCase& c, const fs::path& dir, const CaseResult& out,
+                          Runner& runner) {
+  MethodResult result;
+  result.method = runner.method.name;
+  result.frames = out.frames;
+  result.registered = static_cast<int>(runner.record->registered());
+  result.trajectory = runner.record->trajectory();
+  const nlohmann::json summary = runner.record->Summary();
+  result.measures["ms_per_frame"] = summary["ms_per_frame"];
+  result.measures["skip_reasons"] = summary.value("skip_reasons", nlohmann::json::object());
+  // The method's own log beside the sequence (per-frame status and reason, trajectory).
+  const fs::path method_dir = dir / runner.method.name;
+  fs::create_directories(method_dir);
+  runner.record->WriteTables(method_dir);
+  runner.record->WriteStats(method_dir / "stats.json", {{"method", runner.method.name}});
+  try {
+    if (result.trajectory.empty()) throw InputError("no frame was registered");
+    if (runner.method.sweep_only) {
+      const eval::PairwiseError pairwise =
+          eval::ContactPairwiseError(out.gt_dir, result.trajectory);
+      result.measures["pairwise_error_mm"] = {
+          {"mean", pairwise.mean_mm}, {"std", pairwise.std_mm}, {"samples", pairwise.samples}};
+      const eval::TrajectoryError drift = eval::CompareTrajectory(out.gt_dir, result.trajectory);
+      result.measures["trajectory_error_mm"] = {{"mean", drift.mean_mm}, {"max", drift.max_mm}};
+    } else {
+      const fusion::ModelSnapshot model = runner.stage->Snapshot();
+      runner.stage.reset();  // The volume's memory, before Poisson needs its own.
+      MeshAndMeasure(c, out.gt_dir, model, runner.options.meshing, result);
+    }
+    result.ok = true;
+  } catch (const std::exception& error) {
+    result.error = error.what();
+  }
+  runner.stage.reset();
+  return result;
+}
+
+// Open3D's baseline's result: its trajectory, times and meshes.
+MethodResult FinishOpen3d(const BenchCase& c, const CaseResult& out,
+                          std::unique_ptr<Open3dBaseline> open3d) {
+  MethodResult result;
+  result.method = "open3d";
+  result.frames = out.frames;
+  try {
+    Open3dBaselineResult o3d = open3d->Finish();
+    open3d.reset();
+    result.registered = static_cast<int>(o3d.trajectory.size());
+    result.trajectory = std::move(o3d.trajectory);
+    result.measures["ms_per_frame"] = {{"odometry", o3d.odometry_ms},
+                                       {"integrate", o3d.integrate_ms},
+                                       {"fusion", o3d.odometry_ms + o3d.integrate_ms}};
+    result.measures["odometry_failures"] = o3d.odometry_failures;
+    if (result.trajectory.empty()) throw InputError("no frame was registered");
+    // Open3D's baseline keeps no free-space views: its closure is Poisson's alone.
+    MeshAndMeasure(c, out.gt_dir, {std::move(o3d.raw), fusion::FreeSpace()},
+                   app::ScannerOptions().meshing, result);
+    result.ok = true;
+  } catch (const std::exception& error) {
+    result.error = error.what();
+  }
+  return result;
+}
+
+// The whole application on the same recording: frames per second and peak memory.
+void RunApplication(const BenchCase& c, const fs::path& dir, const RunOptions& options,
+                    CaseResult& out) {
+  const fs::path app_out = dir / "app";
+  const std::string command = "'" + options.app.string() + "' replay '" +
+                              (dir / "sequence.oni").string() + "' --out '" + app_out.string() +
+                              "' --quiet > /dev/null 2>&1";
+  if (std::system(command.c_str()) == 0) {
+    std::ifstream stats(app_out / "stats.json");
+    const nlohmann::json json = nlohmann::json::parse(stats, nullptr, false);
+    if (!json.is_discarded() && json.contains("summary")) {
+      out.app_fps = json["summary"].value("frames_per_second", 0.0);
+      out.app_peak_mib = json["summary"].value("peak_rss_mib", 0.0);
+    }
+  } else if (!options.quiet) {
+    std::fprintf(stderr, "inhandscan-bench: %s: the application's replay failed\n", c.name.c_str());
+  }
+}
+
 }  // namespace
 
 CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
@@ -140,146 +272,28 @@ CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
   out.truth = ReadTumTrajectory(out.gt_dir / "trajectory.txt");
   const std::vector<tracker::HandJointsRow> gt_joints =
       tracker::ReadHandJointsCsv(out.gt_dir / "hand_joints.csv");
-
-  auto source = sensor::OpenInput((dir / "sequence.oni").string());
-  source->Start();
-  const CameraIntrinsics intrinsics = source->Intrinsics();
-  const app::ScannerOptions base;
-  app::HandStage hand(base, intrinsics);
+  app::SequentialOptions run;
+  if (c.init_from_gt) {
+    if (gt_joints.empty()) throw InputError(c.name + ": no ground-truth joints to start from");
+    run.first_joints_mm = gt_joints.front().joints_mm;
+  }
+  app::SequentialScan scan((dir / "sequence.oni").string(), run);
+  app::HandStage hand(app::ScannerOptions(), scan.intrinsics());
   std::vector<Runner> runners;
   for (const Method& method : methods) {
     Runner runner{method, OptionsFor(method), nullptr, nullptr};
-    runner.stage = std::make_unique<app::ObjectStage>(runner.options, intrinsics);
+    runner.stage = std::make_unique<app::ObjectStage>(runner.options, scan.intrinsics());
     runner.record = std::make_unique<app::ScanRecord>(hand.BoneNames());
     runners.push_back(std::move(runner));
   }
   std::unique_ptr<Open3dBaseline> open3d;
-  if (options.open3d && Open3dAvailable()) open3d = std::make_unique<Open3dBaseline>(intrinsics);
+  if (options.open3d && Open3dAvailable())
+    open3d = std::make_unique<Open3dBaseline>(scan.intrinsics());
 
-  double joint_error_sum = 0, track_ms = 0, mask_ms = 0;
-  int frames = 0;
-  while (true) {
-    const sensor::SourceRead read = source->Next(std::chrono::seconds(5));
-    if (read.status == sensor::SourceStatus::kTimeout) continue;
-    if (read.status != sensor::SourceStatus::kFrame) break;
-    if (frames == 0 && c.init_from_gt) {
-      if (gt_joints.empty()) throw InputError(c.name + ": no ground-truth joints to start from");
-      hand.Initialise(tracker::FitPoseToJoints(hand.model(), gt_joints.front().joints_mm));
-    }
-    app::FramePacket packet;
-    packet.frame = read.frame;
-    hand.Process(packet);
-    track_ms += packet.track.milliseconds;
-    mask_ms += packet.mask_ms;
-    const std::int64_t index = read.frame->index;
-    if (!packet.track.joints_mm.empty() && index < static_cast<std::int64_t>(gt_joints.size())) {
-      joint_error_sum +=
-          tracker::MeanJointError(packet.track.joints_mm, gt_joints[index].joints_mm);
-      ++out.tracked_frames;
-    }
-    for (Runner& runner : runners) {
-      app::FramePacket copy = packet;
-      runner.stage->Process(copy);
-      runner.record->Add(copy);
-    }
-    if (open3d) {
-      char name[32];
-      std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(index));
-      const cv::Mat labels =
-          cv::imread((out.gt_dir / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
-      std::vector<std::uint8_t> keep(read.frame->PixelCount(), 0);
-      if (labels.total() == keep.size() && labels.isContinuous()) {
-        for (size_t i = 0; i < keep.size(); ++i) keep[i] = labels.data[i] == render::kObject;
-      }
-      open3d->Process(*read.frame, keep);
-    }
-    ++frames;
-    if (!options.quiet && frames % 200 == 0)
-      std::fprintf(stderr, "inhandscan-bench: %s frame %d\n", c.name.c_str(), frames);
-  }
-  if (frames == 0) throw InputError(c.name + ": no frames");
-  out.joint_error_mm = out.tracked_frames ? joint_error_sum / out.tracked_frames : 0;
-  out.track_ms = track_ms / frames;
-  out.mask_ms = mask_ms / frames;
-
-  for (Runner& runner : runners) {
-    MethodResult result;
-    result.method = runner.method.name;
-    result.frames = frames;
-    result.registered = static_cast<int>(runner.record->registered());
-    result.trajectory = runner.record->trajectory();
-    const nlohmann::json summary = runner.record->Summary();
-    result.measures["ms_per_frame"] = summary["ms_per_frame"];
-    result.measures["skip_reasons"] = summary.value("skip_reasons", nlohmann::json::object());
-    // The method's own log beside the sequence (per-frame status and reason, trajectory).
-    const fs::path method_dir = dir / runner.method.name;
-    fs::create_directories(method_dir);
-    runner.record->WriteTables(method_dir);
-    runner.record->WriteStats(method_dir / "stats.json", {{"method", runner.method.name}});
-    try {
-      if (result.trajectory.empty()) throw InputError("no frame was registered");
-      if (runner.method.sweep_only) {
-        const eval::PairwiseError pairwise =
-            eval::ContactPairwiseError(out.gt_dir, result.trajectory);
-        result.measures["pairwise_error_mm"] = {
-            {"mean", pairwise.mean_mm}, {"std", pairwise.std_mm}, {"samples", pairwise.samples}};
-        const eval::TrajectoryError drift = eval::CompareTrajectory(out.gt_dir, result.trajectory);
-        result.measures["trajectory_error_mm"] = {{"mean", drift.mean_mm}, {"max", drift.max_mm}};
-      } else {
-        const fusion::ModelSnapshot model = runner.stage->Snapshot();
-        runner.stage.reset();  // The volume's memory, before Poisson needs its own.
-        MeshAndMeasure(c, out.gt_dir, model, runner.options.meshing, result);
-      }
-      result.ok = true;
-    } catch (const std::exception& error) {
-      result.error = error.what();
-    }
-    runner.stage.reset();
-    out.methods.push_back(std::move(result));
-  }
-
-  if (open3d) {
-    MethodResult result;
-    result.method = "open3d";
-    result.frames = frames;
-    try {
-      Open3dBaselineResult o3d = open3d->Finish();
-      open3d.reset();
-      result.registered = static_cast<int>(o3d.trajectory.size());
-      result.trajectory = std::move(o3d.trajectory);
-      result.measures["ms_per_frame"] = {{"odometry", o3d.odometry_ms},
-                                         {"integrate", o3d.integrate_ms},
-                                         {"fusion", o3d.odometry_ms + o3d.integrate_ms}};
-      result.measures["odometry_failures"] = o3d.odometry_failures;
-      if (result.trajectory.empty()) throw InputError("no frame was registered");
-      // Open3D's baseline keeps no free-space views: its closure is Poisson's alone.
-      MeshAndMeasure(c, out.gt_dir, {std::move(o3d.raw), fusion::FreeSpace()}, base.meshing,
-                     result);
-      result.ok = true;
-    } catch (const std::exception& error) {
-      result.error = error.what();
-    }
-    out.methods.push_back(std::move(result));
-  }
-
-  if (!options.app.empty()) {
-    // The whole application on the same recording: frames per second and peak memory.
-    const fs::path app_out = dir / "app";
-    const std::string command = "'" + options.app.string() + "' replay '" +
-                                (dir / "sequence.oni").string() + "' --out '" + app_out.string() +
-                                "' --quiet > /dev/null 2>&1";
-    if (std::system(command.c_str()) == 0) {
-      std::ifstream stats(app_out / "stats.json");
-      const nlohmann::json json = nlohmann::json::parse(stats, nullptr, false);
-      if (!json.is_discarded() && json.contains("summary")) {
-        out.app_fps = json["summary"].value("frames_per_second", 0.0);
-        out.app_peak_mib = json["summary"].value("peak_rss_mib", 0.0);
-      }
-    } else if (!options.quiet) {
-      std::fprintf(stderr, "inhandscan-bench: %s: the application's replay failed\n",
-                   c.name.c_str());
-    }
-  }
+  ScanFrames(c, scan, hand, gt_joints, runners, open3d.get(), options.quiet, out);
+  for (Runner& runner : runners) out.methods.push_back(FinishMethod(c, dir, out, runner));
+  if (open3d) out.methods.push_back(FinishOpen3d(c, out, std::move(open3d)));
+  if (!options.app.empty()) RunApplication(c, dir, options, out);
   return out;
 }
 

@@ -72,6 +72,7 @@ struct MethodResult {
 struct CaseResult {
   BenchCase bench_case;
   std::filesystem::path gt_dir;
+  int frames = 0;  ///< Frames read.
   /// Hand tracker: mean joint error over frames with a pose, mm; ms per frame.
   double joint_error_mm = 0;
   int tracked_frames = 0;

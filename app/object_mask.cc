@@ -1,4 +1,4 @@
-#include "fusion/object_mask.h"
+#include "app/object_mask.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "core/check.h"
 
-namespace ihs::fusion {
+namespace ihs::app {
 
 int RemoveMeshPixels(const TriangleMesh& mesh, const Frame& frame,
                      const CameraIntrinsics& intrinsics, int dilation_px, double depth_margin_mm,
@@ -99,4 +99,4 @@ int RemoveMeshPixels(const TriangleMesh& mesh, const Frame& frame,
   return cleared;
 }
 
-}  // namespace ihs::fusion
+}  // namespace ihs::app

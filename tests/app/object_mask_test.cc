@@ -1,6 +1,6 @@
 // Taking the posed hand model's pixels out of the object mask.
 
-#include "fusion/object_mask.h"
+#include "app/object_mask.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "tests/mesh_fixtures.h"
 
-namespace ihs::fusion {
+namespace ihs::app {
 namespace {
 
 // A flat wall at `depth_mm`, all of it object.
@@ -91,4 +91,4 @@ TEST(ObjectMaskTest, AModelBehindTheObservedSurfaceLeavesTheMaskAlone) {
 }
 
 }  // namespace
-}  // namespace ihs::fusion
+}  // namespace ihs::app

@@ -10,7 +10,7 @@
 #include "core/frame.h"
 #include "core/triangle_mesh.h"
 
-namespace ihs::fusion {
+namespace ihs::app {
 
 /// Clears the entries of `object_mask` (one per pixel of `frame`) that `mesh` (camera frame, mm)
 /// covers where it lies no more than `depth_margin_mm` behind the observed depth, dilated by
@@ -19,4 +19,4 @@ int RemoveMeshPixels(const TriangleMesh& mesh, const Frame& frame,
                      const CameraIntrinsics& intrinsics, int dilation_px, double depth_margin_mm,
                      std::vector<std::uint8_t>* object_mask);
 
-}  // namespace ihs::fusion
+}  // namespace ihs::app
