@@ -304,6 +304,208 @@ std::vector<double> Blend(const std::vector<double>& a, const std::vector<double
   return out;
 }
 
+// Timeline: per grasp close, hold (turning), open, and — between grasps — turn back.
+struct Timeline {
+  int grasps = 1;
+  // The object's turn per grasp, rad.
+  double step_rad = 0;
+  // Frames to close the fingers (and to open them).
+  int close_frames = 2;
+  // Frames to turn the hand back between two grasps.
+  int back_frames = 2;
+  // Frames of holding, all grasps together.
+  int hold_total = 0;
+
+  // Frames of grasp k's hold (the last one takes the remainder).
+  int hold_frames(int k) const {
+    return hold_total / grasps + (k == grasps - 1 ? hold_total % grasps : 0);
+  }
+};
+
+Timeline MakeTimeline(const ScriptedMotionOptions& options) {
+  Timeline t;
+  t.grasps = std::max(
+      1, static_cast<int>(std::ceil(options.turns * 360.0 / options.turn_per_grasp_deg - 1e-9)));
+  t.step_rad = options.turns * 2 * M_PI / t.grasps;
+  const double per_grasp = static_cast<double>(options.frames) / t.grasps;
+  t.close_frames = std::max(2, static_cast<int>(std::lround(0.1 * per_grasp)));
+  t.back_frames = std::max(2, static_cast<int>(std::lround(0.22 * per_grasp)));
+  t.hold_total = options.frames - t.grasps * 2 * t.close_frames - (t.grasps - 1) * t.back_frames;
+  IHS_CHECK_ARG(t.hold_total >= t.grasps * 4,
+                "scripted.frames is too small for " << t.grasps << " grasps");
+  return t;
+}
+
+// Where the object is: its axis leaning toward the camera, its centre `centre` ahead; turned
+// about its axis so that the wrist starts on the side of a person facing the camera that the
+// hand belongs to (a right hand on the image's left), half a grasp before straight sideways.
+Rigid3 StartObjectPose(const HandModel& hand, const ObjectShape& object,
+                       const ScriptedMotionOptions& options, const Grasp& first, double step_rad,
+                       const Eigen::Vector3d& centre) {
+  const double tilt = options.tilt_deg * M_PI / 180;
+  const Eigen::Vector3d axis(0, -std::cos(tilt), -std::sin(tilt));
+  const bool right_hand = tracker::IsRightHand(hand);
+  const Eigen::Vector3d side(right_hand ? -1.0 : 1.0, 0, 0);
+  const Eigen::Vector3d wrist = first.object_from_root.translation();
+  const double wrist_phi = std::atan2(wrist.y(), wrist.x());
+  // About the axis from `side`: toward +z (behind the object) on the right, toward -z on the
+  // left. A right hand's wrist passes the mirror images of a left hand's positions (for 90°
+  // grasps from 62° behind to 28° in front of straight sideways), in the other order.
+  const double start_phi =
+      right_hand ? -(std::atan2(0.3, 1.0) + step_rad / 2) : std::atan2(0.3, 1.0) - step_rad / 2;
+  // The start azimuth turns the same way round for either hand (a mirror image).
+  const double psi = start_phi - wrist_phi +
+                     (right_hand ? -1.0 : 1.0) * options.start_azimuth_deg * M_PI / 180;
+  const Eigen::Vector3d b = Eigen::AngleAxisd(psi, axis) * side;
+  Eigen::Matrix3d rotation;
+  rotation.col(0) = b;
+  rotation.col(1) = axis.cross(b);
+  rotation.col(2) = axis;
+  return Rigid3(rotation, centre - rotation * Eigen::Vector3d(0, 0, object.height_mm() / 2));
+}
+
+// Object pose at the start of each grasp (and at the end of the last): nominal turn plus a
+// seeded sway about its centre.
+std::vector<Rigid3> GraspStartPoses(const Rigid3& cam_from_object0, const Eigen::Vector3d& centre,
+                                    const Timeline& timeline, const ScriptedMotionOptions& options,
+                                    std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Rigid3> grasp_start;
+  for (int k = 0; k <= timeline.grasps; ++k) {
+    Rigid3 sway;
+    if (k > 0 && k < timeline.grasps) {
+      const Eigen::Vector3d tilt_axis(unit(rng), 0, unit(rng));
+      const double angle = options.sway_deg * M_PI / 180 * unit(rng);
+      const Eigen::Vector3d shift(unit(rng), unit(rng), unit(rng));
+      const Rigid3 turn = Rigid3::FromAxisAngle(
+          tilt_axis.norm() > 1e-6 ? tilt_axis : Eigen::Vector3d::UnitX(), angle);
+      sway = Rigid3::Translation(centre + options.sway_mm * shift) * turn *
+             Rigid3::Translation(-centre);
+    }
+    grasp_start.push_back(sway * cam_from_object0 *
+                          Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), k * timeline.step_rad));
+  }
+  return grasp_start;
+}
+
+// Each grasp's fingers, closed onto the object at its turned-back relative pose.
+// A body of revolution looks the same turned, so the first grasp turned back serves every
+// grasp; any other shape gets its grasp solved again where the hand now meets it.
+std::vector<Grasp> PlanHolds(GraspPlanner& planner, const Grasp& first, const ObjectShape& object,
+                             const Timeline& timeline) {
+  const double step_rad = timeline.step_rad;
+  std::vector<Grasp> holds;
+  for (int k = 0; k < timeline.grasps; ++k) {
+    Grasp grasp = first;
+    grasp.object_from_root =
+        Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -k * step_rad) * first.object_from_root;
+    if (k > 0 && !object.rotationally_symmetric()) grasp = planner.Solve(-k * step_rad, &grasp);
+    planner.Close(grasp);
+    holds.push_back(grasp);
+  }
+  return holds;
+}
+
+// Emits a scripted motion's frames grasp by grasp; while the object is held its contacts slip
+// (a seeded random walk about its axis).
+class MotionEmitter {
+ public:
+  MotionEmitter(const HandModel& hand, const ObjectShape& object,
+                const ScriptedMotionOptions& options, const Timeline& timeline,
+                const std::vector<Rigid3>& grasp_start, const std::vector<Grasp>& holds,
+                std::mt19937& rng)
+      : hand_(hand),
+        options_(options),
+        timeline_(timeline),
+        grasp_start_(grasp_start),
+        holds_(holds),
+        rng_(rng),
+        slip_radius_(std::max(5.0, object.RadiusAt(GraspHeight(object)))) {}
+
+  // Grasp k: close, hold (turning), open, and — unless it is the last — turn back.
+  void EmitGrasp(int k) {
+    const Grasp& g = holds_[k];
+    EmitFingers(grasp_start_[k], g, g.open_rad, g.closed_rad);
+    EmitHold(k);
+    EmitFingers(grasp_start_[k + 1], g, g.closed_rad, g.open_rad);
+    if (k + 1 < timeline_.grasps) EmitTurnBack(k);
+  }
+
+  Motion Take() { return std::move(motion_); }
+
+ private:
+  void Emit(const Rigid3& cam_from_object_nominal, const Rigid3& object_from_root,
+            const std::vector<double>& angles, bool held) {
+    if (held && options_.slip_mm > 0)
+      slip_rad_ += options_.slip_mm / slip_radius_ * slip_step_(rng_);
+    MotionFrame frame;
+    frame.cam_from_object =
+        cam_from_object_nominal * Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), slip_rad_);
+    frame.cam_from_bone = tracker::ForwardKinematics(
+        hand_, HandPose{cam_from_object_nominal * object_from_root, angles});
+    frame.held = held;
+    motion_.frames.push_back(std::move(frame));
+  }
+
+  // Closes or opens grasp g's fingers from angles `from` to `to`, the object still at
+  // `cam_from_object`.
+  void EmitFingers(const Rigid3& cam_from_object, const Grasp& g, const std::vector<double>& from,
+                   const std::vector<double>& to) {
+    const int frames = timeline_.close_frames;
+    for (int i = 0; i < frames; ++i)
+      Emit(cam_from_object, g.object_from_root, Blend(from, to, Smooth((i + 1.0) / frames)), false);
+  }
+
+  // Grasp k holds the object while it turns from one grasp start to the next.
+  void EmitHold(int k) {
+    const Grasp& g = holds_[k];
+    const double step_rad = timeline_.step_rad;
+    const int hold_frames = timeline_.hold_frames(k);
+    for (int i = 0; i < hold_frames; ++i) {
+      const double s = Smooth((i + 1.0) / hold_frames);
+      const Rigid3& start = grasp_start_[k];
+      const Rigid3& end = grasp_start_[k + 1];
+      // Interpolate the turn about the object's own axis separately from the sway, so a turn of
+      // up to 180° follows the axis rather than the shortest rotation.
+      const Rigid3 sway_start =
+          start * Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -k * step_rad);
+      const Rigid3 sway_end =
+          end * Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -(k + 1) * step_rad);
+      const Rigid3 nominal = sway_start.Interpolate(sway_end, s) *
+                             Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), (k + s) * step_rad);
+      Emit(nominal, g.object_from_root, g.closed_rad, true);
+    }
+  }
+
+  // The open hand turns back from grasp k to grasp k + 1.
+  void EmitTurnBack(int k) {
+    const Grasp& g = holds_[k];
+    const Grasp& next = holds_[k + 1];
+    const double step_rad = timeline_.step_rad;
+    const int back_frames = timeline_.back_frames;
+    for (int i = 0; i < back_frames; ++i) {
+      const double s = Smooth((i + 1.0) / back_frames);
+      const Rigid3 turned_next =
+          Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), step_rad) * next.object_from_root;
+      const Rigid3 object_from_root =
+          Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -s * step_rad) *
+          g.object_from_root.Interpolate(turned_next, s);
+      Emit(grasp_start_[k + 1], object_from_root, Blend(g.open_rad, next.open_rad, s), false);
+    }
+  }
+
+  const HandModel& hand_;
+  const ScriptedMotionOptions& options_;
+  const Timeline& timeline_;
+  const std::vector<Rigid3>& grasp_start_;
+  const std::vector<Grasp>& holds_;
+  std::mt19937& rng_;
+  std::normal_distribution<double> slip_step_{0.0, 1.0};
+  double slip_rad_ = 0.0;
+  const double slip_radius_;
+  Motion motion_;
+};
+
 }  // namespace
 
 void ScriptedMotionOptions::Check() const {
@@ -339,128 +541,17 @@ Motion MakeScriptedMotion(const HandModel& hand, const ObjectShape& object,
   options.Check();
   GraspPlanner planner(hand, object, options);
   const Grasp first = planner.Solve(0.0);
-
-  // Timeline: per grasp close, hold (turning), open, and — between grasps — turn back.
-  const int grasps = std::max(
-      1, static_cast<int>(std::ceil(options.turns * 360.0 / options.turn_per_grasp_deg - 1e-9)));
-  const double step_rad = options.turns * 2 * M_PI / grasps;
-  const double per_grasp = static_cast<double>(options.frames) / grasps;
-  const int close_frames = std::max(2, static_cast<int>(std::lround(0.1 * per_grasp)));
-  const int back_frames = std::max(2, static_cast<int>(std::lround(0.22 * per_grasp)));
-  const int hold_total = options.frames - grasps * 2 * close_frames - (grasps - 1) * back_frames;
-  IHS_CHECK_ARG(hold_total >= grasps * 4,
-                "scripted.frames is too small for " << grasps << " grasps");
-
-  // Where the object is: its axis leaning toward the camera, its centre ahead; turned about its
-  // axis so that the wrist starts on the side of a person facing the camera that the hand
-  // belongs to (a right hand on the image's left), half a grasp before straight sideways.
-  const double tilt = options.tilt_deg * M_PI / 180;
-  const Eigen::Vector3d axis(0, -std::cos(tilt), -std::sin(tilt));
-  const bool right_hand = tracker::IsRightHand(hand);
-  const Eigen::Vector3d side(right_hand ? -1.0 : 1.0, 0, 0);
-  const Eigen::Vector3d wrist = first.object_from_root.translation();
-  const double wrist_phi = std::atan2(wrist.y(), wrist.x());
-  // About the axis from `side`: toward +z (behind the object) on the right, toward -z on the
-  // left. A right hand's wrist passes the mirror images of a left hand's positions (for 90°
-  // grasps from 62° behind to 28° in front of straight sideways), in the other order.
-  const double start_phi =
-      right_hand ? -(std::atan2(0.3, 1.0) + step_rad / 2) : std::atan2(0.3, 1.0) - step_rad / 2;
-  // The start azimuth turns the same way round for either hand (a mirror image).
-  const double psi = start_phi - wrist_phi +
-                     (right_hand ? -1.0 : 1.0) * options.start_azimuth_deg * M_PI / 180;
-  const Eigen::Vector3d b = Eigen::AngleAxisd(psi, axis) * side;
-  Eigen::Matrix3d rotation;
-  rotation.col(0) = b;
-  rotation.col(1) = axis.cross(b);
-  rotation.col(2) = axis;
+  const Timeline timeline = MakeTimeline(options);
   const Eigen::Vector3d centre(0, 0, options.distance_mm);
-  const Rigid3 cam_from_object0(rotation,
-                                centre - rotation * Eigen::Vector3d(0, 0, object.height_mm() / 2));
-
-  // Object pose at the start of each grasp: nominal turn plus a seeded sway about its centre.
+  const Rigid3 cam_from_object0 =
+      StartObjectPose(hand, object, options, first, timeline.step_rad, centre);
   std::mt19937 rng(options.seed);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  std::vector<Rigid3> grasp_start;
-  for (int k = 0; k <= grasps; ++k) {
-    Rigid3 sway;
-    if (k > 0 && k < grasps) {
-      const Eigen::Vector3d tilt_axis(unit(rng), 0, unit(rng));
-      const double angle = options.sway_deg * M_PI / 180 * unit(rng);
-      const Eigen::Vector3d shift(unit(rng), unit(rng), unit(rng));
-      const Rigid3 turn = Rigid3::FromAxisAngle(
-          tilt_axis.norm() > 1e-6 ? tilt_axis : Eigen::Vector3d::UnitX(), angle);
-      sway = Rigid3::Translation(centre + options.sway_mm * shift) * turn *
-             Rigid3::Translation(-centre);
-    }
-    grasp_start.push_back(sway * cam_from_object0 *
-                          Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), k * step_rad));
-  }
-
-  // Each grasp's fingers, closed onto the object at its turned-back relative pose.
-  // A body of revolution looks the same turned, so the first grasp turned back serves every
-  // grasp; any other shape gets its grasp solved again where the hand now meets it.
-  std::vector<Grasp> holds;
-  for (int k = 0; k < grasps; ++k) {
-    Grasp grasp = first;
-    grasp.object_from_root =
-        Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -k * step_rad) * first.object_from_root;
-    if (k > 0 && !object.rotationally_symmetric()) grasp = planner.Solve(-k * step_rad, &grasp);
-    planner.Close(grasp);
-    holds.push_back(grasp);
-  }
-
-  Motion motion;
-  std::normal_distribution<double> slip_step(0.0, 1.0);
-  double slip_rad = 0.0;
-  const double slip_radius = std::max(5.0, object.RadiusAt(GraspHeight(object)));
-  auto emit = [&](const Rigid3& cam_from_object_nominal, const Rigid3& object_from_root,
-                  const std::vector<double>& angles, bool held) {
-    if (held && options.slip_mm > 0) slip_rad += options.slip_mm / slip_radius * slip_step(rng);
-    MotionFrame frame;
-    frame.cam_from_object =
-        cam_from_object_nominal * Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), slip_rad);
-    frame.cam_from_bone = tracker::ForwardKinematics(
-        hand, HandPose{cam_from_object_nominal * object_from_root, angles});
-    frame.held = held;
-    motion.frames.push_back(std::move(frame));
-  };
-  for (int k = 0; k < grasps; ++k) {
-    const Grasp& g = holds[k];
-    const int hold_frames = hold_total / grasps + (k == grasps - 1 ? hold_total % grasps : 0);
-    for (int i = 0; i < close_frames; ++i)
-      emit(grasp_start[k], g.object_from_root,
-           Blend(g.open_rad, g.closed_rad, Smooth((i + 1.0) / close_frames)), false);
-    for (int i = 0; i < hold_frames; ++i) {
-      const double s = Smooth((i + 1.0) / hold_frames);
-      const Rigid3& start = grasp_start[k];
-      const Rigid3& end = grasp_start[k + 1];
-      // Interpolate the turn about the object's own axis separately from the sway, so a turn of
-      // up to 180° follows the axis rather than the shortest rotation.
-      const Rigid3 sway_start =
-          start * Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -k * step_rad);
-      const Rigid3 sway_end =
-          end * Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -(k + 1) * step_rad);
-      const Rigid3 nominal = sway_start.Interpolate(sway_end, s) *
-                             Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), (k + s) * step_rad);
-      emit(nominal, g.object_from_root, g.closed_rad, true);
-    }
-    for (int i = 0; i < close_frames; ++i)
-      emit(grasp_start[k + 1], g.object_from_root,
-           Blend(g.closed_rad, g.open_rad, Smooth((i + 1.0) / close_frames)), false);
-    if (k + 1 < grasps) {
-      const Grasp& next = holds[k + 1];
-      for (int i = 0; i < back_frames; ++i) {
-        const double s = Smooth((i + 1.0) / back_frames);
-        const Rigid3 turned_next =
-            Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), step_rad) * next.object_from_root;
-        const Rigid3 object_from_root =
-            Rigid3::FromAxisAngle(Eigen::Vector3d::UnitZ(), -s * step_rad) *
-            g.object_from_root.Interpolate(turned_next, s);
-        emit(grasp_start[k + 1], object_from_root, Blend(g.open_rad, next.open_rad, s), false);
-      }
-    }
-  }
-  return motion;
+  const std::vector<Rigid3> grasp_start =
+      GraspStartPoses(cam_from_object0, centre, timeline, options, rng);
+  const std::vector<Grasp> holds = PlanHolds(planner, first, object, timeline);
+  MotionEmitter emitter(hand, object, options, timeline, grasp_start, holds, rng);
+  for (int k = 0; k < timeline.grasps; ++k) emitter.EmitGrasp(k);
+  return emitter.Take();
 }
 
 }  // namespace ihs::synth

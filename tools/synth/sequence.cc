@@ -70,6 +70,260 @@ json IntrinsicsJson(const CameraIntrinsics& c) {
           {"cy", c.cy}, {"width", c.width}, {"height", c.height}};
 }
 
+// Creates gt/ and gt/labels/.
+void CreateGroundTruthFolder(const fs::path& gt) {
+  std::error_code error;
+  fs::create_directories(gt / "labels", error);
+  if (error) throw OutputError(gt.string() + ": cannot create (" + error.message() + ")");
+}
+
+// The recording as the user gets it: the .oni file and the TUM directory, each when asked for.
+struct SensorWriters {
+  SensorWriters(const SequenceOptions& options, const fs::path& out) {
+    if (options.write_oni) {
+      sensor::OniWriterOptions oni_options;
+      oni_options.intrinsics = options.intrinsics;
+      oni_options.fps = options.fps;
+      oni = std::make_unique<sensor::OniWriter>(out / "sequence.oni", oni_options);
+    }
+    if (options.write_tum)
+      tum = std::make_unique<sensor::TumWriter>(out / "tum", options.intrinsics);
+  }
+
+  void Write(const Frame& frame) {
+    if (oni) oni->Write(frame);
+    if (tum) tum->Write(frame);
+  }
+
+  // Closes the .oni file and completes the TUM directory.
+  void Finish() {
+    if (oni) oni->Close();
+    if (tum) tum->Finish();
+  }
+
+  std::unique_ptr<sensor::OniWriter> oni;
+  std::unique_ptr<sensor::TumWriter> tum;
+};
+
+// The per-frame ground truth (object trajectory, hand joints, contacts), gathered while the
+// frames are rendered and written at the end, with the summary of held frames and penetration.
+class GroundTruth {
+ public:
+  explicit GroundTruth(const SequenceRenderer& renderer) : renderer_(renderer) {
+    const tracker::HandModel& hand = renderer.hand();
+    for (const auto& bone : hand.bones) bone_names_.push_back(bone.name);
+    std::vector<int> tip_fingers;
+    for (int bone : renderer.geometry().fingertip_bones())
+      tip_fingers.push_back(hand.FingerOf(bone));
+    contacts_csv_ = "frame,held";
+    for (int f : tip_fingers) contacts_csv_ += std::string(",") + kFingerNames[f] + "_touch";
+    for (int f : tip_fingers) contacts_csv_ += std::string(",") + kFingerNames[f] + "_mm";
+    contacts_csv_ += ",penetration_mm\n";
+  }
+
+  // Adds frame i.
+  void Add(int i, const RenderedFrame& rendered) {
+    const double t = rendered.frame.depth_timestamp_us * 1e-6;
+    trajectory_.push_back({t, rendered.cam_from_object});
+    joints_.push_back({i, rendered.joints_mm});
+    const HandObjectContact& contact = rendered.contact;
+    std::string row = std::to_string(i) + "," + (rendered.held ? "1" : "0");
+    for (const auto& tip : contact.fingertips) row += tip.touching ? ",1" : ",0";
+    char number[32];
+    for (const auto& tip : contact.fingertips) {
+      std::snprintf(number, sizeof number, ",%.3f", std::min(tip.distance_mm, 999.0));
+      row += number;
+    }
+    std::snprintf(number, sizeof number, ",%.3f\n", contact.max_penetration_mm);
+    contacts_csv_ += row + number;
+    summary_.held_frames += rendered.held ? 1 : 0;
+    summary_.max_penetration_mm = std::max(summary_.max_penetration_mm, contact.max_penetration_mm);
+  }
+
+  // Held frames and deepest penetration so far (the rest of the summary left unset).
+  const SequenceSummary& summary() const { return summary_; }
+
+  // Writes trajectory.txt, object.ply, hand_joints.csv and contacts.csv into `gt`.
+  void Write(const fs::path& gt) const {
+    WriteTumTrajectory(
+        gt / "trajectory.txt", trajectory_,
+        {"cam_from_object of " + renderer_.object().name() + " (mm), one pose per frame"});
+    WriteMesh(gt / "object.ply", renderer_.object_mesh());
+    tracker::WriteHandJointsCsv(gt / "hand_joints.csv", bone_names_, joints_);
+    WriteFileAtomically(gt / "contacts.csv", contacts_csv_);
+  }
+
+ private:
+  const SequenceRenderer& renderer_;
+  std::vector<std::string> bone_names_;
+  std::vector<StampedPose> trajectory_;
+  std::vector<tracker::HandJointsRow> joints_;
+  std::string contacts_csv_;
+  SequenceSummary summary_;
+};
+
+// The rendered frame's labels as an image (sharing its data).
+cv::Mat LabelsMat(const RenderedFrame& rendered) {
+  return cv::Mat(rendered.frame.height, rendered.frame.width, CV_8UC1,
+                 const_cast<std::uint8_t*>(rendered.labels.data()));
+}
+
+// Writes frame i's labels as gt/labels/NNNNNN.png.
+void WriteLabels(const fs::path& gt, int i, const cv::Mat& labels) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d.png", i);
+  WritePng(gt / "labels" / name, labels);
+}
+
+// The contact sheet: a few frames' colour, colour-mapped depth and labels side by side.
+class ContactSheet {
+ public:
+  // Picks the sheet's frames out of `count`.
+  explicit ContactSheet(int count) {
+    // Fractions of the sequence that fall on different phases of a periodic motion.
+    for (double fraction : {0.1, 0.3, 0.55, 0.85}) {
+      frames_.push_back(static_cast<int>(fraction * (count - 1)));
+    }
+  }
+
+  // Keeps frame i's panels when it is one of the sheet's frames; `labels` is LabelsMat's image.
+  void Add(int i, const RenderedFrame& rendered, const cv::Mat& labels) {
+    if (std::find(frames_.begin(), frames_.end(), i) == frames_.end()) return;
+    const Frame& frame = rendered.frame;
+    cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
+    cv::Mat bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    panels_.push_back(
+        {bgr, DepthImage(frame), LabelImage(rendered.labels, frame.width, frame.height)});
+    const cv::Rect box = cv::boundingRect(labels);
+    box_ = box_.area() == 0 ? box : (box_ | box);
+  }
+
+  // Writes the sheet, cropped to where the hand and object are (with a margin and the label).
+  void Write(const fs::path& path, const CameraIntrinsics& intrinsics) {
+    const int margin = 30;
+    box_ = cv::Rect(box_.x - margin, box_.y - margin, box_.width + 2 * margin,
+                    box_.height + 2 * margin);
+    box_ &= cv::Rect(0, 0, intrinsics.width, intrinsics.height);
+    std::vector<cv::Mat> rows;
+    for (size_t r = 0; r < panels_.size(); ++r) {
+      const auto& panels = panels_[r];
+      cv::putText(panels[0], "frame " + std::to_string(frames_[r]), {box_.x + 5, box_.y + 20},
+                  cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1);
+      cv::Mat row;
+      cv::hconcat(std::vector<cv::Mat>{panels[0](box_), panels[1](box_), panels[2](box_)}, row);
+      rows.push_back(row);
+    }
+    cv::Mat sheet;
+    cv::vconcat(rows, sheet);
+    WritePng(path, sheet);
+  }
+
+ private:
+  std::vector<int> frames_;
+  std::vector<std::array<cv::Mat, 3>> panels_;
+  cv::Rect box_;
+};
+
+// The sensor model's options, for the manifest.
+json SensorJson(const SensorModelOptions& s) {
+  return {{"depth_noise", s.depth_noise},
+          {"noise_coefficient_per_mm", s.noise_coefficient_per_mm},
+          {"quantization", s.quantization},
+          {"baseline_mm", s.baseline_mm},
+          {"subpixel", s.subpixel},
+          {"grazing_dropout", s.grazing_dropout},
+          {"max_incidence_deg", s.max_incidence_deg},
+          {"silhouette_effects", s.silhouette_effects},
+          {"edge_jump_mm", s.edge_jump_mm},
+          {"edge_dropout_probability", s.edge_dropout_probability},
+          {"flying_probability", s.flying_probability},
+          {"color_noise", s.color_noise},
+          {"color_sigma", s.color_sigma},
+          {"misregistration", s.misregistration},
+          {"max_misregistration_px", s.max_misregistration_px}};
+}
+
+// A recorded motion's options and placement report, for the manifest.
+json RecordedJson(const RecordedMotionOptions& rc, const RecordedMotionReport& r) {
+  return {{"contact_mm", rc.contact_mm},
+          {"max_penetration_mm", rc.max_penetration_mm},
+          {"prior_weight", rc.prior_weight},
+          {"slip_mm", rc.slip_mm},
+          {"report",
+           {{"placed_frames", r.frames},
+            {"grasp_frame", r.grasp_frame},
+            {"held_frames", r.held_frames},
+            {"carried_within_3mm_share", r.carried_within_3mm_share},
+            {"placed_within_3mm_share", r.placed_within_3mm_share},
+            {"penetration_p95_mm", r.penetration_p95_mm},
+            {"penetration_max_mm", r.penetration_max_mm}}}};
+}
+
+// A scripted motion's options and grasp height, for the manifest.
+json ScriptedJson(const ScriptedMotionOptions& sc, const ObjectShape& object) {
+  return {{"frames", sc.frames},
+          {"turns", sc.turns},
+          {"turn_per_grasp_deg", sc.turn_per_grasp_deg},
+          {"distance_mm", sc.distance_mm},
+          {"tilt_deg", sc.tilt_deg},
+          {"start_azimuth_deg", sc.start_azimuth_deg},
+          {"sway_mm", sc.sway_mm},
+          {"sway_deg", sc.sway_deg},
+          {"press_mm", sc.press_mm},
+          {"release_mm", sc.release_mm},
+          {"slip_mm", sc.slip_mm},
+          {"seed", sc.seed},
+          {"grasp_height_mm", GraspHeight(object)}};
+}
+
+// The manifest: every parameter of the sequence and its summary.
+json ManifestJson(const SequenceRenderer& renderer, const SequenceSummary& summary) {
+  const SequenceOptions& options = renderer.options();
+  const ObjectShape& object = renderer.object();
+  const int count = renderer.frame_count();
+  const int last = options.first_frame + (count - 1) * options.frame_step;
+  json manifest = {
+      {"generator", "inhandscan-synth " IHS_VERSION},
+      {"object",
+       {{"spec", options.object},
+        {"name", object.name()},
+        {"height_mm", object.height_mm()},
+        {"max_radius_mm", object.max_radius_mm()},
+        {"textured", object.textured()},
+        {"volume_mm3", object.mesh().Volume()}}},
+      {"motion", options.motion},
+      {"hand", renderer.hand_source()},
+      {"hand_scale", options.hand_scale},
+      {"left_hand", options.left_hand},
+      {"hand_bones", renderer.hand().bones.size()},
+      {"frames",
+       {{"first", options.first_frame},
+        {"last", last},
+        {"step", options.frame_step},
+        {"count", count}}},
+      {"seed", options.seed},
+      {"fps", options.fps},
+      {"touch_mm", options.touch_mm},
+      {"hand_rgb", options.hand_rgb},
+      {"object_rgb", options.object_rgb},
+      {"intrinsics", IntrinsicsJson(options.intrinsics)},
+      {"sensor", SensorJson(options.sensor)},
+      {"summary",
+       {{"frames", count},
+        {"held_frames", summary.held_frames},
+        {"max_penetration_mm", summary.max_penetration_mm},
+        {"seconds", summary.seconds}}},
+  };
+  const bool recorded = options.motion != "scripted";
+  if (recorded) {
+    manifest["recorded"] = RecordedJson(options.recorded, renderer.recorded_report());
+  } else {
+    manifest["scripted"] = ScriptedJson(options.scripted, renderer.object());
+  }
+  return manifest;
+}
+
 }  // namespace
 
 void SequenceOptions::Check() const {
@@ -164,199 +418,33 @@ RenderedFrame SequenceRenderer::Render(int i) {
 SequenceSummary GenerateSequence(const SequenceOptions& options, const fs::path& out) {
   const auto started = std::chrono::steady_clock::now();
   SequenceRenderer renderer(options);
-  const ObjectShape& object = renderer.object();
-  const tracker::HandModel& hand = renderer.hand();
-  const HandObjectGeometry& geometry = renderer.geometry();
-  const RecordedMotionReport& recorded_report = renderer.recorded_report();
-  const bool recorded = options.motion != "scripted";
   const int count = renderer.frame_count();
-  const int last = options.first_frame + (count - 1) * options.frame_step;
 
   // Outputs.
   const fs::path gt = out / "gt";
-  std::error_code error;
-  fs::create_directories(gt / "labels", error);
-  if (error) throw OutputError(gt.string() + ": cannot create (" + error.message() + ")");
-  std::unique_ptr<sensor::OniWriter> oni;
-  if (options.write_oni) {
-    sensor::OniWriterOptions oni_options;
-    oni_options.intrinsics = options.intrinsics;
-    oni_options.fps = options.fps;
-    oni = std::make_unique<sensor::OniWriter>(out / "sequence.oni", oni_options);
-  }
-  std::unique_ptr<sensor::TumWriter> tum;
-  if (options.write_tum) tum = std::make_unique<sensor::TumWriter>(out / "tum", options.intrinsics);
-
-  std::vector<std::string> bone_names;
-  for (const auto& bone : hand.bones) bone_names.push_back(bone.name);
-  std::vector<StampedPose> trajectory;
-  std::vector<tracker::HandJointsRow> joints;
-  std::string contacts_csv = "frame,held";
-  std::vector<int> tip_fingers;
-  for (int bone : geometry.fingertip_bones()) tip_fingers.push_back(hand.FingerOf(bone));
-  for (int f : tip_fingers) contacts_csv += std::string(",") + kFingerNames[f] + "_touch";
-  for (int f : tip_fingers) contacts_csv += std::string(",") + kFingerNames[f] + "_mm";
-  contacts_csv += ",penetration_mm\n";
-
-  SequenceSummary summary;
-  std::vector<int> sheet_frames;
-  // Fractions of the sequence that fall on different phases of a periodic motion.
-  for (double fraction : {0.1, 0.3, 0.55, 0.85}) {
-    sheet_frames.push_back(static_cast<int>(fraction * (count - 1)));
-  }
-  std::vector<std::array<cv::Mat, 3>> sheet_panels;
-  cv::Rect sheet_box;
+  CreateGroundTruthFolder(gt);
+  SensorWriters sensor(options, out);
+  GroundTruth truth(renderer);
+  ContactSheet sheet(count);
   for (int i = 0; i < count; ++i) {
     const RenderedFrame rendered = renderer.Render(i);
-    const Frame& frame = rendered.frame;
-    if (oni) oni->Write(frame);
-    if (tum) tum->Write(frame);
-
-    const double t = frame.depth_timestamp_us * 1e-6;
-    trajectory.push_back({t, rendered.cam_from_object});
-    joints.push_back({i, rendered.joints_mm});
-    const HandObjectContact& contact = rendered.contact;
-    std::string row = std::to_string(i) + "," + (rendered.held ? "1" : "0");
-    for (const auto& tip : contact.fingertips) row += tip.touching ? ",1" : ",0";
-    char number[32];
-    for (const auto& tip : contact.fingertips) {
-      std::snprintf(number, sizeof number, ",%.3f", std::min(tip.distance_mm, 999.0));
-      row += number;
-    }
-    std::snprintf(number, sizeof number, ",%.3f\n", contact.max_penetration_mm);
-    contacts_csv += row + number;
-    summary.held_frames += rendered.held ? 1 : 0;
-    summary.max_penetration_mm = std::max(summary.max_penetration_mm, contact.max_penetration_mm);
-
-    cv::Mat labels(frame.height, frame.width, CV_8UC1,
-                   const_cast<std::uint8_t*>(rendered.labels.data()));
-    char name[32];
-    std::snprintf(name, sizeof name, "%06d.png", i);
-    WritePng(gt / "labels" / name, labels);
-    if (std::find(sheet_frames.begin(), sheet_frames.end(), i) != sheet_frames.end()) {
-      cv::Mat rgb(frame.height, frame.width, CV_8UC3, const_cast<std::uint8_t*>(frame.rgb.data()));
-      cv::Mat bgr;
-      cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-      sheet_panels.push_back(
-          {bgr, DepthImage(frame), LabelImage(rendered.labels, frame.width, frame.height)});
-      const cv::Rect box = cv::boundingRect(labels);
-      sheet_box = sheet_box.area() == 0 ? box : (sheet_box | box);
-    }
+    sensor.Write(rendered.frame);
+    truth.Add(i, rendered);
+    const cv::Mat labels = LabelsMat(rendered);
+    WriteLabels(gt, i, labels);
+    sheet.Add(i, rendered, labels);
   }
-  if (oni) oni->Close();
-  if (tum) tum->Finish();
+  sensor.Finish();
+  SequenceSummary summary = truth.summary();
   summary.frames = count;
-  summary.recorded = recorded_report;
+  summary.recorded = renderer.recorded_report();
 
-  WriteTumTrajectory(gt / "trajectory.txt", trajectory,
-                     {"cam_from_object of " + object.name() + " (mm), one pose per frame"});
-  WriteMesh(gt / "object.ply", renderer.object_mesh());
-  tracker::WriteHandJointsCsv(gt / "hand_joints.csv", bone_names, joints);
-  WriteFileAtomically(gt / "contacts.csv", contacts_csv);
+  truth.Write(gt);
   WriteFileAtomically(gt / "intrinsics.json", IntrinsicsJson(options.intrinsics).dump(2) + "\n");
-  // The contact sheet, cropped to where the hand and object are (with a margin and the label).
-  const int margin = 30;
-  sheet_box = cv::Rect(sheet_box.x - margin, sheet_box.y - margin, sheet_box.width + 2 * margin,
-                       sheet_box.height + 2 * margin);
-  sheet_box &= cv::Rect(0, 0, options.intrinsics.width, options.intrinsics.height);
-  std::vector<cv::Mat> rows;
-  for (size_t r = 0; r < sheet_panels.size(); ++r) {
-    const auto& panels = sheet_panels[r];
-    cv::putText(panels[0], "frame " + std::to_string(sheet_frames[r]),
-                {sheet_box.x + 5, sheet_box.y + 20}, cv::FONT_HERSHEY_SIMPLEX, 0.6,
-                cv::Scalar(255, 255, 255), 1);
-    cv::Mat row;
-    cv::hconcat(
-        std::vector<cv::Mat>{panels[0](sheet_box), panels[1](sheet_box), panels[2](sheet_box)},
-        row);
-    rows.push_back(row);
-  }
-  cv::Mat sheet;
-  cv::vconcat(rows, sheet);
-  WritePng(out / "contact_sheet.png", sheet);
-
+  sheet.Write(out / "contact_sheet.png", options.intrinsics);
   summary.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const auto& s = options.sensor;
-  const auto& sc = options.scripted;
-  const auto& rc = options.recorded;
-  json manifest = {
-      {"generator", "inhandscan-synth " IHS_VERSION},
-      {"object",
-       {{"spec", options.object},
-        {"name", object.name()},
-        {"height_mm", object.height_mm()},
-        {"max_radius_mm", object.max_radius_mm()},
-        {"textured", object.textured()},
-        {"volume_mm3", object.mesh().Volume()}}},
-      {"motion", options.motion},
-      {"hand", renderer.hand_source()},
-      {"hand_scale", options.hand_scale},
-      {"left_hand", options.left_hand},
-      {"hand_bones", bone_names.size()},
-      {"frames",
-       {{"first", options.first_frame},
-        {"last", last},
-        {"step", options.frame_step},
-        {"count", count}}},
-      {"seed", options.seed},
-      {"fps", options.fps},
-      {"touch_mm", options.touch_mm},
-      {"hand_rgb", options.hand_rgb},
-      {"object_rgb", options.object_rgb},
-      {"intrinsics", IntrinsicsJson(options.intrinsics)},
-      {"sensor",
-       {{"depth_noise", s.depth_noise},
-        {"noise_coefficient_per_mm", s.noise_coefficient_per_mm},
-        {"quantization", s.quantization},
-        {"baseline_mm", s.baseline_mm},
-        {"subpixel", s.subpixel},
-        {"grazing_dropout", s.grazing_dropout},
-        {"max_incidence_deg", s.max_incidence_deg},
-        {"silhouette_effects", s.silhouette_effects},
-        {"edge_jump_mm", s.edge_jump_mm},
-        {"edge_dropout_probability", s.edge_dropout_probability},
-        {"flying_probability", s.flying_probability},
-        {"color_noise", s.color_noise},
-        {"color_sigma", s.color_sigma},
-        {"misregistration", s.misregistration},
-        {"max_misregistration_px", s.max_misregistration_px}}},
-      {"summary",
-       {{"frames", count},
-        {"held_frames", summary.held_frames},
-        {"max_penetration_mm", summary.max_penetration_mm},
-        {"seconds", summary.seconds}}},
-  };
-  if (recorded) {
-    const auto& r = recorded_report;
-    manifest["recorded"] = {{"contact_mm", rc.contact_mm},
-                            {"max_penetration_mm", rc.max_penetration_mm},
-                            {"prior_weight", rc.prior_weight},
-                            {"slip_mm", rc.slip_mm},
-                            {"report",
-                             {{"placed_frames", r.frames},
-                              {"grasp_frame", r.grasp_frame},
-                              {"held_frames", r.held_frames},
-                              {"carried_within_3mm_share", r.carried_within_3mm_share},
-                              {"placed_within_3mm_share", r.placed_within_3mm_share},
-                              {"penetration_p95_mm", r.penetration_p95_mm},
-                              {"penetration_max_mm", r.penetration_max_mm}}}};
-  } else {
-    manifest["scripted"] = {{"frames", sc.frames},
-                            {"turns", sc.turns},
-                            {"turn_per_grasp_deg", sc.turn_per_grasp_deg},
-                            {"distance_mm", sc.distance_mm},
-                            {"tilt_deg", sc.tilt_deg},
-                            {"start_azimuth_deg", sc.start_azimuth_deg},
-                            {"sway_mm", sc.sway_mm},
-                            {"sway_deg", sc.sway_deg},
-                            {"press_mm", sc.press_mm},
-                            {"release_mm", sc.release_mm},
-                            {"slip_mm", sc.slip_mm},
-                            {"seed", sc.seed},
-                            {"grasp_height_mm", GraspHeight(object)}};
-  }
-  WriteFileAtomically(gt / "manifest.json", manifest.dump(2) + "\n");
+  WriteFileAtomically(gt / "manifest.json", ManifestJson(renderer, summary).dump(2) + "\n");
   return summary;
 }
 
