@@ -55,6 +55,14 @@ std::vector<Eigen::Vector3f> VoxelCentroids(const std::vector<Eigen::Vector3f>& 
   return centroids;
 }
 
+// Every n-th of `points`, n chosen to keep at most about `at_most` of them (an even subsample).
+std::vector<Eigen::Vector3f> EveryNth(const std::vector<Eigen::Vector3f>& points, size_t at_most) {
+  const size_t stride = std::max<size_t>(1, points.size() / at_most);
+  std::vector<Eigen::Vector3f> kept;
+  for (size_t i = 0; i < points.size(); i += stride) kept.push_back(points[i]);
+  return kept;
+}
+
 // Closest points of segments [p0, p1] and [q0, q1]: parameters s, t in [0, 1].
 void ClosestPointsOfSegments(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
                              const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, double* s,
@@ -127,137 +135,6 @@ std::vector<int> NearestSetPixels(const std::vector<std::uint8_t>& mask, int wid
 }
 
 }  // namespace
-
-HandFitCost::HandFitCost(const HandModel& model, const Eigen::Matrix3d& reference_rotation,
-                         const CameraIntrinsics& intrinsics, HandFitTerms terms,
-                         double collision_weight, double limit_weight, double prior_weight,
-                         std::vector<double> prior_rad)
-    : model_(model),
-      reference_(reference_rotation),
-      intrinsics_(intrinsics),
-      terms_(std::move(terms)),
-      collision_sqrt_(std::sqrt(collision_weight)),
-      limit_weight_(limit_weight),
-      prior_weight_(prior_weight),
-      prior_(std::move(prior_rad)),
-      dofs_(JointDegreesOfFreedom(model)),
-      derivatives_(model) {
-  IHS_CHECK(prior_.size() == dofs_.size(),
-            "prior has " << prior_.size() << " angles, the model " << dofs_.size());
-  const int n = derivatives_.size();
-  size_t plane_rows = 0;
-  for (const PlanePair& pair : terms_.planes) plane_rows += pair.point_weight > 0 ? 3 : 1;
-  set_num_residuals(static_cast<int>(3 * terms_.points.size() + plane_rows +
-                                     2 * terms_.silhouette.size() + terms_.collisions.size() +
-                                     2 * dofs_.size()));
-  mutable_parameter_block_sizes()->push_back(n);
-}
-
-bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
-                           double** jacobians) const {
-  const double* x = parameters[0];
-  const int n = derivatives_.size();
-  derivatives_.Evaluate(reference_, x);
-  double* jacobian = jacobians ? jacobians[0] : nullptr;
-  if (jacobian) std::fill(jacobian, jacobian + static_cast<size_t>(num_residuals()) * n, 0.0);
-  int row = 0;
-  std::vector<double> point_jacobian(3 * n);
-  auto skinned = [&](int vertex) {
-    return derivatives_.SkinnedPoint(model_.weights[vertex], model_.rest_mesh.vertices[vertex],
-                                     jacobian ? point_jacobian.data() : nullptr);
-  };
-  for (const PointPair& pair : terms_.points) {
-    const Eigen::Vector3d p = skinned(pair.vertex);
-    for (int r = 0; r < 3; ++r) {
-      residuals[row + r] = pair.weight * (p[r] - pair.target[r]);
-      if (jacobian) {
-        for (int c = 0; c < n; ++c)
-          jacobian[(row + r) * n + c] = pair.weight * point_jacobian[r * n + c];
-      }
-    }
-    row += 3;
-  }
-  for (const PlanePair& pair : terms_.planes) {
-    const Eigen::Vector3d p = skinned(pair.vertex);
-    const Eigen::Vector3d& normal = pair.normal;
-    if (pair.point_weight <= 0) {
-      residuals[row] = pair.weight * normal.dot(p - pair.target);
-      if (jacobian) {
-        for (int c = 0; c < n; ++c) {
-          double d = 0;
-          for (int r = 0; r < 3; ++r) d += normal[r] * point_jacobian[r * n + c];
-          jacobian[row * n + c] = pair.weight * d;
-        }
-      }
-      ++row;
-      continue;
-    }
-    // A = p·I + b·n·nᵀ, b = √(p² + w²) − p: normal component weighted √(p² + w²), tangential p.
-    const double a = pair.point_weight;
-    const double b = std::sqrt(a * a + pair.weight * pair.weight) - a;
-    const Eigen::Vector3d residual =
-        a * (p - pair.target) + b * normal.dot(p - pair.target) * normal;
-    for (int r = 0; r < 3; ++r) residuals[row + r] = residual[r];
-    if (jacobian) {
-      for (int c = 0; c < n; ++c) {
-        const Eigen::Vector3d column(point_jacobian[c], point_jacobian[n + c],
-                                     point_jacobian[2 * n + c]);
-        const Eigen::Vector3d d = a * column + b * normal.dot(column) * normal;
-        for (int r = 0; r < 3; ++r) jacobian[(row + r) * n + c] = d[r];
-      }
-    }
-    row += 3;
-  }
-  for (const SilhouettePair& pair : terms_.silhouette) {
-    const Eigen::Vector3d p = skinned(pair.vertex);
-    const double z = std::max(p.z(), 1.0), focal[2] = {intrinsics_.fx, intrinsics_.fy};
-    const Eigen::Vector2d pixel = intrinsics_.Project(Eigen::Vector3d(p.x(), p.y(), z));
-    for (int r = 0; r < 2; ++r) {
-      residuals[row + r] = pair.weight * (pixel[r] - pair.target[r]);
-      if (jacobian) {
-        // d(f·p_r/z + c) = f/z·dp_r − f·p_r/z²·dz.
-        for (int c = 0; c < n; ++c) {
-          jacobian[(row + r) * n + c] =
-              pair.weight * focal[r] / z *
-              (point_jacobian[r * n + c] - p[r] / z * point_jacobian[2 * n + c]);
-        }
-      }
-    }
-    row += 2;
-  }
-  std::vector<double> jacobian_b(3 * n);
-  for (const CollisionPair& pair : terms_.collisions) {
-    const Eigen::Vector3d a = derivatives_.BonePoint(pair.bone_a, pair.point_a,
-                                                     jacobian ? point_jacobian.data() : nullptr);
-    const Eigen::Vector3d b =
-        derivatives_.BonePoint(pair.bone_b, pair.point_b, jacobian ? jacobian_b.data() : nullptr);
-    const double distance = (a - b).norm();
-    const double depth = pair.radius_a + pair.radius_b - distance;
-    residuals[row] = depth > 0 ? collision_sqrt_ * depth : 0.0;
-    if (jacobian && depth > 0 && distance > 1e-9) {
-      const Eigen::Vector3d normal = (a - b) / distance;
-      for (int c = 0; c < n; ++c) {
-        double d = 0;
-        for (int r = 0; r < 3; ++r)
-          d += normal[r] * (point_jacobian[r * n + c] - jacobian_b[r * n + c]);
-        jacobian[row * n + c] = -collision_sqrt_ * d;
-      }
-    }
-    ++row;
-  }
-  for (size_t k = 0; k < dofs_.size(); ++k) {
-    const auto [lo_deg, hi_deg] = model_.limits[dofs_[k].bone].limits_deg[dofs_[k].axis];
-    const double angle = x[6 + k], lo = lo_deg * M_PI / 180, hi = hi_deg * M_PI / 180;
-    const double excess = angle > hi ? angle - hi : (angle < lo ? angle - lo : 0.0);
-    residuals[row] = limit_weight_ * excess;
-    if (jacobian && excess != 0) jacobian[row * n + 6 + k] = limit_weight_;
-    ++row;
-    residuals[row] = prior_weight_ * (angle - prior_[k]);
-    if (jacobian) jacobian[row * n + 6 + k] = prior_weight_;
-    ++row;
-  }
-  return true;
-}
 
 void HandFitOptions::Check() const {
   IHS_CHECK_ARG(collision_weight >= 0, "hand_fit.collision_weight must be >= 0");
@@ -348,314 +225,399 @@ HandFitter::HandFitter(const HandModel& model, const CameraIntrinsics& intrinsic
 
 HandFitter::~HandFitter() = default;
 
-HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
-                              const HandPose& initial, const Segmentation* segmentation) const {
-  HandFitResult result;
-  result.pose = initial;
-  if (hand_points.empty()) return result;
+// The state of one Fit call: the data fitted to, the pose being fitted, the model's samples
+// posed at it and the silhouette around its image; one method per step of the fit.
+class HandFitter::FitState {
+ public:
+  FitState(const HandFitter& fitter, const std::vector<Eigen::Vector3f>& hand_points,
+           const Frame* frame, const HandPose& initial, const Segmentation* segmentation);
+
+  /// One correspondence update (`first`: the fit's first): pairs the model at the current pose
+  /// with the data and solves the inner problem from there. False, with the pose left as it
+  /// was, when there is no pair to fit.
+  bool Iterate(bool first);
+  /// The current pose and how well it explains the data, and the data the model.
+  HandFitResult Result();
+
+ private:
+  void PoseSamples();
+  std::vector<int> FindVisible() const;
+  bool OutsideCrop(const Eigen::Vector3d& p) const;
+  double HuberWeight(double distance) const;
+  PointKdTree FacingTree() const;
+  std::vector<PointPair> ModelToDataPairs(const std::vector<int>& visible_samples) const;
+  double NearestUnlabelled(const Eigen::Vector3f& point, Eigen::Vector3d* out) const;
+  std::vector<PlanePair> DataToModelPairs() const;
+  void WeighPairs(std::vector<PointPair>* model_pairs, std::vector<PlanePair>* data_pairs) const;
+  std::vector<CollisionPair> CloseCollisions() const;
+  void PrepareSilhouette();
+  std::array<int, 4> ModelImageRoi() const;
+  void AddUnlabelledToSilhouette();
+  std::vector<SilhouettePair> SilhouettePairs() const;
+  void Solve(HandFitTerms terms);
+
+  const HandModel& model_;
+  const CameraIntrinsics& intrinsics_;
+  const HandFitOptions& options_;
+  const Data& precomputed_;  // The fitter's samples and capsules.
+  const Frame* const frame_;
+  const Segmentation* const segmentation_;
 
   // Data: an even subsample for data → model (of the cubes' centroids, or of the points), a
   // denser one for the tree. How well the pose explains the data is measured on the points
   // themselves (every n-th), a share of the hand's pixels whichever data the fit used.
-  auto every_nth = [&](const std::vector<Eigen::Vector3f>& points) {
-    const size_t stride =
-        std::max<size_t>(1, points.size() / static_cast<size_t>(options_.max_data_points));
-    std::vector<Eigen::Vector3f> kept;
-    for (size_t i = 0; i < points.size(); i += stride) kept.push_back(points[i]);
-    return kept;
-  };
-  const std::vector<Eigen::Vector3f> measured = every_nth(hand_points);
-  const std::vector<Eigen::Vector3f> data =
-      options_.data_voxel_mm > 0 ? every_nth(VoxelCentroids(hand_points, options_.data_voxel_mm))
-                                 : measured;
-  const size_t tree_stride = std::max<size_t>(1, hand_points.size() / 4000);
-  std::vector<Eigen::Vector3f> tree_points;
-  for (size_t i = 0; i < hand_points.size(); i += tree_stride)
-    tree_points.push_back(hand_points[i]);
-  const PointKdTree data_tree(std::move(tree_points));
-  result.data_points = static_cast<int>(data.size());
+  const std::vector<Eigen::Vector3f> measured_;
+  const std::vector<Eigen::Vector3f> data_;
+  const PointKdTree data_tree_;
 
-  PoseDerivatives kinematics(model_);
-  const std::vector<double> prior = initial.angles_rad;
-  HandPose pose = initial;
-  const int samples = static_cast<int>(data_->samples.size());
-  std::vector<Eigen::Vector3f> posed(samples);
-  std::vector<Eigen::Vector3d> normals(samples);
-  std::vector<bool> visible(samples, false);
-  std::vector<int> facing;  // Samples facing the camera.
-  auto pose_samples = [&](const HandPose& at) {
-    const PoseParameters parameters(at);
-    kinematics.Evaluate(parameters.reference_rotation(), parameters.values().data());
-    const auto& cam_from_bone = kinematics.cam_from_bone();
-    facing.clear();
-    for (int i = 0; i < samples; ++i) {
-      const int v = data_->samples[i];
-      const int bone = data_->sample_bone[i];
-      posed[i] = kinematics.SkinnedPoint(model_.weights[v], model_.rest_mesh.vertices[v], nullptr)
-                     .cast<float>();
-      normals[i] = cam_from_bone[bone].RotateVector(data_->rest_normal_in_bone[i]);
-      if (normals[i].dot(posed[i].cast<double>()) < 0) facing.push_back(i);
-    }
-  };
-  // Visible samples: facing the camera, in front in a coarse depth buffer of the model (8 px
-  // cells), and — with a depth image — not hidden behind something nearer (the object).
-  auto find_visible = [&]() {
-    const int cw = (intrinsics_.width + 7) / 8, ch = (intrinsics_.height + 7) / 8;
-    std::vector<float> nearest(static_cast<size_t>(cw) * ch,
-                               std::numeric_limits<float>::infinity());
-    std::vector<int> cell(samples, -1);
-    std::vector<Eigen::Vector2d> pixel(samples);
-    for (int i : facing) {
-      const Eigen::Vector3d p = posed[i].cast<double>();
-      if (p.z() <= 1) continue;
-      pixel[i] = intrinsics_.Project(p);
-      const int cu = static_cast<int>(std::floor(pixel[i].x() / 8));
-      const int cv = static_cast<int>(std::floor(pixel[i].y() / 8));
-      if (cu < 0 || cv < 0 || cu >= cw || cv >= ch) continue;
-      cell[i] = cv * cw + cu;
-      nearest[cell[i]] = std::min(nearest[cell[i]], posed[i].z());
-    }
-    std::vector<int> out;
-    std::fill(visible.begin(), visible.end(), false);
-    for (int i : facing) {
-      if (cell[i] < 0 || posed[i].z() > nearest[cell[i]] + 8.0f) continue;
-      const Eigen::Vector3d p = posed[i].cast<double>();
-      if ((p.array() < options_.crop_min_mm.array()).any() ||
-          (p.array() > options_.crop_max_mm.array()).any()) {
-        continue;
-      }
-      if (frame) {
-        const int u = static_cast<int>(std::lround(pixel[i].x()));
-        const int v = static_cast<int>(std::lround(pixel[i].y()));
-        // Outside the image, or behind something nearer: hidden. Where the image has no depth
-        // (background) the point stays: the model must not leave the hand's silhouette.
-        if (u < 0 || v < 0 || u >= frame->width || v >= frame->height) continue;
-        const std::uint16_t z = frame->depth_mm[static_cast<size_t>(v) * frame->width + u];
-        if (z != 0 && z < posed[i].z() - kOccluderMm) continue;
-      }
-      visible[i] = true;
-      out.push_back(i);
-    }
-    return out;
-  };
-  auto huber = [&](double distance) {
-    return distance <= options_.robust_scale_mm ? 1.0
-                                                : std::sqrt(options_.robust_scale_mm / distance);
-  };
+  PoseDerivatives kinematics_;
+  const std::vector<double> prior_;
+  HandPose pose_;
+  const int samples_;
+  std::vector<Eigen::Vector3f> posed_;
+  std::vector<Eigen::Vector3d> normals_;
+  std::vector<int> facing_;  // Samples facing the camera.
 
   // The silhouette (hand and object pixels) and, around the model's image, each pixel's
   // nearest silhouette pixel.
-  const bool use_silhouette = segmentation != nullptr && options_.silhouette_weight > 0 &&
-                              segmentation->width > 0 &&
-                              segmentation->hand_mask.size() == segmentation->object_mask.size();
-  std::vector<std::uint8_t> silhouette;
-  std::vector<int> nearest_silhouette;
-  std::array<int, 4> roi = {0, 0, 0, 0};
-  // Once the samples are posed at the initial pose: the region around the model's image.
-  auto prepare_silhouette = [&]() {
-    silhouette.resize(segmentation->hand_mask.size());
-    for (size_t p = 0; p < silhouette.size(); ++p)
-      silhouette[p] = segmentation->hand_mask[p] | segmentation->object_mask[p];
-    constexpr int kMarginPx = 40;
-    roi = {segmentation->width, segmentation->height, 0, 0};
-    for (const Eigen::Vector3f& p : posed) {
-      if (p.z() <= 1) continue;
-      const Eigen::Vector2d pixel = intrinsics_.Project(p.cast<double>());
-      roi[0] = std::min(roi[0], static_cast<int>(pixel.x()) - kMarginPx);
-      roi[1] = std::min(roi[1], static_cast<int>(pixel.y()) - kMarginPx);
-      roi[2] = std::max(roi[2], static_cast<int>(pixel.x()) + kMarginPx);
-      roi[3] = std::max(roi[3], static_cast<int>(pixel.y()) + kMarginPx);
+  const bool use_silhouette_;
+  std::vector<std::uint8_t> silhouette_;
+  std::vector<int> nearest_silhouette_;
+  std::array<int, 4> roi_ = {0, 0, 0, 0};
+};
+
+HandFitter::FitState::FitState(const HandFitter& fitter,
+                               const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
+                               const HandPose& initial, const Segmentation* segmentation)
+    : model_(fitter.model_),
+      intrinsics_(fitter.intrinsics_),
+      options_(fitter.options_),
+      precomputed_(*fitter.data_),
+      frame_(frame),
+      segmentation_(segmentation),
+      measured_(EveryNth(hand_points, static_cast<size_t>(options_.max_data_points))),
+      data_(options_.data_voxel_mm > 0
+                ? EveryNth(VoxelCentroids(hand_points, options_.data_voxel_mm),
+                           static_cast<size_t>(options_.max_data_points))
+                : measured_),
+      data_tree_(EveryNth(hand_points, 4000)),
+      kinematics_(model_),
+      prior_(initial.angles_rad),
+      pose_(initial),
+      samples_(static_cast<int>(precomputed_.samples.size())),
+      posed_(samples_),
+      normals_(samples_),
+      use_silhouette_(segmentation != nullptr && options_.silhouette_weight > 0 &&
+                      segmentation->width > 0 &&
+                      segmentation->hand_mask.size() == segmentation->object_mask.size()) {}
+
+bool HandFitter::FitState::Iterate(bool first) {
+  PoseSamples();
+  if (first && use_silhouette_) PrepareSilhouette();
+  const std::vector<int> visible_samples = FindVisible();
+  std::vector<PointPair> model_pairs = ModelToDataPairs(visible_samples);
+  std::vector<PlanePair> data_pairs = DataToModelPairs();
+  if (model_pairs.empty() && data_pairs.empty()) return false;
+  WeighPairs(&model_pairs, &data_pairs);
+  Solve({std::move(model_pairs), std::move(data_pairs), SilhouettePairs(), CloseCollisions()});
+  return true;
+}
+
+// Poses the samples at the current pose: their points, normals and which face the camera.
+void HandFitter::FitState::PoseSamples() {
+  const PoseParameters parameters(pose_);
+  kinematics_.Evaluate(parameters.reference_rotation(), parameters.values().data());
+  const auto& cam_from_bone = kinematics_.cam_from_bone();
+  facing_.clear();
+  for (int i = 0; i < samples_; ++i) {
+    const int v = precomputed_.samples[i];
+    const int bone = precomputed_.sample_bone[i];
+    posed_[i] = kinematics_.SkinnedPoint(model_.weights[v], model_.rest_mesh.vertices[v], nullptr)
+                    .cast<float>();
+    normals_[i] = cam_from_bone[bone].RotateVector(precomputed_.rest_normal_in_bone[i]);
+    if (normals_[i].dot(posed_[i].cast<double>()) < 0) facing_.push_back(i);
+  }
+}
+
+// Visible samples: facing the camera, in front in a coarse depth buffer of the model (8 px
+// cells), and — with a depth image — not hidden behind something nearer (the object).
+std::vector<int> HandFitter::FitState::FindVisible() const {
+  const int cw = (intrinsics_.width + 7) / 8, ch = (intrinsics_.height + 7) / 8;
+  std::vector<float> nearest(static_cast<size_t>(cw) * ch, std::numeric_limits<float>::infinity());
+  std::vector<int> cell(samples_, -1);
+  std::vector<Eigen::Vector2d> pixel(samples_);
+  for (int i : facing_) {
+    const Eigen::Vector3d p = posed_[i].cast<double>();
+    if (p.z() <= 1) continue;
+    pixel[i] = intrinsics_.Project(p);
+    const int cu = static_cast<int>(std::floor(pixel[i].x() / 8));
+    const int cv = static_cast<int>(std::floor(pixel[i].y() / 8));
+    if (cu < 0 || cv < 0 || cu >= cw || cv >= ch) continue;
+    cell[i] = cv * cw + cu;
+    nearest[cell[i]] = std::min(nearest[cell[i]], posed_[i].z());
+  }
+  std::vector<int> out;
+  for (int i : facing_) {
+    if (cell[i] < 0 || posed_[i].z() > nearest[cell[i]] + 8.0f) continue;
+    if (OutsideCrop(posed_[i].cast<double>())) continue;
+    if (frame_) {
+      const int u = static_cast<int>(std::lround(pixel[i].x()));
+      const int v = static_cast<int>(std::lround(pixel[i].y()));
+      // Outside the image, or behind something nearer: hidden. Where the image has no depth
+      // (background) the point stays: the model must not leave the hand's silhouette.
+      if (u < 0 || v < 0 || u >= frame_->width || v >= frame_->height) continue;
+      const std::uint16_t z = frame_->depth_mm[static_cast<size_t>(v) * frame_->width + u];
+      if (z != 0 && z < posed_[i].z() - kOccluderMm) continue;
     }
-    roi = {std::max(0, roi[0]), std::max(0, roi[1]), std::min(segmentation->width, roi[2]),
-           std::min(segmentation->height, roi[3])};
-    // With unlabelled_match_mm, what the segmentation left out (depth in the crop volume) is
-    // inside the silhouette too.
-    if (options_.unlabelled_match_mm > 0 && frame != nullptr &&
-        frame->depth_mm.size() == silhouette.size()) {
-      for (int v = roi[1]; v < roi[3]; ++v) {
-        for (int u = roi[0]; u < roi[2]; ++u) {
-          const size_t at = static_cast<size_t>(v) * segmentation->width + u;
-          if (silhouette[at] || frame->depth_mm[at] == 0) continue;
-          const Eigen::Vector3d x = intrinsics_.BackProject(u, v, frame->depth_mm[at]);
-          silhouette[at] = (x.array() >= options_.crop_min_mm.array()).all() &&
-                           (x.array() <= options_.crop_max_mm.array()).all();
-        }
-      }
-    }
-    if (roi[2] > roi[0] && roi[3] > roi[1])
-      nearest_silhouette = NearestSetPixels(silhouette, segmentation->width, roi);
-  };
-  // Silhouette pairs: model points (seen or not) in the crop volume whose image lies outside
-  // the silhouette, pulled to within the tolerance of its nearest pixel. The wrist's points are
-  // left out: where a scan of the forearm ends (sleeve, crop) says nothing about the hand.
-  auto silhouette_pairs = [&]() {
-    std::vector<SilhouettePair> pairs;
-    if (nearest_silhouette.empty()) return pairs;
-    int considered = 0;
-    const int roi_width = roi[2] - roi[0];
-    for (int i = 0; i < samples; ++i) {
-      if (data_->sample_bone[i] == 0) continue;
-      const Eigen::Vector3d p = posed[i].cast<double>();
-      if (p.z() <= 1 || (p.array() < options_.crop_min_mm.array()).any() ||
-          (p.array() > options_.crop_max_mm.array()).any()) {
+    out.push_back(i);
+  }
+  return out;
+}
+
+// Whether `p` lies outside the crop volume (HandFitOptions::crop_min_mm, crop_max_mm).
+bool HandFitter::FitState::OutsideCrop(const Eigen::Vector3d& p) const {
+  return (p.array() < options_.crop_min_mm.array()).any() ||
+         (p.array() > options_.crop_max_mm.array()).any();
+}
+
+// The weight of a pair `distance` apart: 1 up to robust_scale_mm, Huber's beyond.
+double HandFitter::FitState::HuberWeight(double distance) const {
+  return distance <= options_.robust_scale_mm ? 1.0
+                                              : std::sqrt(options_.robust_scale_mm / distance);
+}
+
+// A k-d tree of the posed samples facing the camera (its indices index facing_).
+PointKdTree HandFitter::FitState::FacingTree() const {
+  std::vector<Eigen::Vector3f> facing_points;
+  for (int i : facing_) facing_points.push_back(posed_[i]);
+  return PointKdTree(std::move(facing_points));
+}
+
+// Model → data: visible samples to their nearest data point.
+std::vector<PointPair> HandFitter::FitState::ModelToDataPairs(
+    const std::vector<int>& visible_samples) const {
+  const size_t model_stride =
+      std::max<size_t>(1, visible_samples.size() / static_cast<size_t>(options_.max_model_points));
+  std::vector<PointPair> model_pairs;
+  for (size_t k = 0; k < visible_samples.size(); k += model_stride) {
+    const int i = visible_samples[k];
+    float d2 = 0;
+    const int j = data_tree_.Nearest(posed_[i], &d2);
+    const double d = j >= 0 ? std::sqrt(d2) : std::numeric_limits<double>::infinity();
+    // A nearer surface that the segmentation left out instead (HandFitOptions).
+    if (d > options_.unlabelled_match_mm) {
+      Eigen::Vector3d unlabelled;
+      const double du = NearestUnlabelled(posed_[i], &unlabelled);
+      if (du < d) {
+        model_pairs.push_back({precomputed_.samples[i], unlabelled, HuberWeight(du)});
         continue;
       }
-      ++considered;
-      const Eigen::Vector2d pixel = intrinsics_.Project(p);
-      const int u = static_cast<int>(std::lround(pixel.x()));
-      const int v = static_cast<int>(std::lround(pixel.y()));
-      if (u < roi[0] || v < roi[1] || u >= roi[2] || v >= roi[3]) continue;
-      const int site = nearest_silhouette[(v - roi[1]) * roi_width + (u - roi[0])];
-      if (site < 0 || silhouette[site] == 0) continue;
-      const Eigen::Vector2d target(site % segmentation->width, site / segmentation->width);
-      const double distance = (pixel - target).norm();
-      if (distance <= options_.silhouette_tolerance_px) continue;
-      const Eigen::Vector2d inside =
-          target + options_.silhouette_tolerance_px * (pixel - target) / distance;
-      pairs.push_back({data_->samples[i], inside, p.z() / intrinsics_.fx});
     }
-    const double scale =
-        considered == 0 ? 0 : options_.silhouette_weight / std::sqrt(double(considered));
-    for (SilhouettePair& pair : pairs) pair.weight *= scale;
-    return pairs;
-  };
-
-  // The nearest point, within unlabelled_match_mm, of the depth pixels around a model point's
-  // image that neither mask holds (see HandFitOptions).
-  auto nearest_unlabelled = [&](const Eigen::Vector3f& point, Eigen::Vector3d* out) {
-    if (options_.unlabelled_match_mm <= 0 || frame == nullptr || segmentation == nullptr ||
-        segmentation->hand_mask.size() != frame->depth_mm.size() ||
-        segmentation->object_mask.size() != frame->depth_mm.size()) {
-      return std::numeric_limits<double>::infinity();
-    }
-    constexpr int kRadiusPx = 2;
-    const Eigen::Vector3d p = point.cast<double>();
-    const Eigen::Vector2d pixel = intrinsics_.Project(p);
-    const int u0 = static_cast<int>(std::lround(pixel.x()));
-    const int v0 = static_cast<int>(std::lround(pixel.y()));
-    double best = options_.unlabelled_match_mm;
-    bool found = false;
-    for (int v = std::max(0, v0 - kRadiusPx); v <= std::min(frame->height - 1, v0 + kRadiusPx);
-         ++v) {
-      for (int u = std::max(0, u0 - kRadiusPx); u <= std::min(frame->width - 1, u0 + kRadiusPx);
-           ++u) {
-        const size_t at = static_cast<size_t>(v) * frame->width + u;
-        const std::uint16_t z = frame->depth_mm[at];
-        if (z == 0 || segmentation->hand_mask[at] != 0 || segmentation->object_mask[at] != 0) {
-          continue;
-        }
-        const Eigen::Vector3d q = intrinsics_.BackProject(u, v, z);
-        const double d = (q - p).norm();
-        if (d < best) {
-          best = d;
-          *out = q;
-          found = true;
-        }
-      }
-    }
-    return found ? best : std::numeric_limits<double>::infinity();
-  };
-
-  std::vector<int> visible_samples;
-  for (int outer = 0; outer < options_.outer_iterations; ++outer) {
-    pose_samples(pose);
-    if (outer == 0 && use_silhouette) prepare_silhouette();
-    visible_samples = find_visible();
-    const auto& cam_from_bone = kinematics.cam_from_bone();
-
-    // Model → data: visible samples to their nearest data point.
-    const size_t model_stride = std::max<size_t>(
-        1, visible_samples.size() / static_cast<size_t>(options_.max_model_points));
-    std::vector<PointPair> model_pairs;
-    for (size_t k = 0; k < visible_samples.size(); k += model_stride) {
-      const int i = visible_samples[k];
-      float d2 = 0;
-      const int j = data_tree.Nearest(posed[i], &d2);
-      const double d = j >= 0 ? std::sqrt(d2) : std::numeric_limits<double>::infinity();
-      // A nearer surface that the segmentation left out instead (HandFitOptions).
-      if (d > options_.unlabelled_match_mm) {
-        Eigen::Vector3d unlabelled;
-        const double du = nearest_unlabelled(posed[i], &unlabelled);
-        if (du < d) {
-          model_pairs.push_back({data_->samples[i], unlabelled, huber(du)});
-          continue;
-        }
-      }
-      if (d > options_.max_correspondence_mm) continue;
-      model_pairs.push_back({data_->samples[i], data_tree.points()[j].cast<double>(), huber(d)});
-    }
-    // Data → model: data points to the tangent plane of their nearest sample facing the camera.
-    std::vector<Eigen::Vector3f> facing_points;
-    for (int i : facing) facing_points.push_back(posed[i]);
-    const PointKdTree model_tree(std::move(facing_points));
-    std::vector<PlanePair> data_pairs;
-    for (const Eigen::Vector3f& point : data) {
-      float d2 = 0;
-      const int k = model_tree.Nearest(point, &d2);
-      const double d = std::sqrt(d2);
-      if (k < 0 || d > options_.max_correspondence_mm) continue;
-      const int i = facing[k];
-      data_pairs.push_back({data_->samples[i], point.cast<double>(), normals[i], huber(d)});
-    }
-    if (model_pairs.empty() && data_pairs.empty()) break;
-    // Each direction is a mean over its pairs.
-    const double model_scale =
-        model_pairs.empty() ? 0 : 1.0 / std::sqrt(double(model_pairs.size()));
-    for (PointPair& pair : model_pairs) pair.weight *= model_scale;
-    const double data_scale = data_pairs.empty() ? 0 : 1.0 / std::sqrt(double(data_pairs.size()));
-    for (PlanePair& pair : data_pairs) pair.weight *= data_scale;
-    // The data → model pairs also as points: a plane lets a finger slide along its axis.
-    for (PlanePair& pair : data_pairs) pair.point_weight = options_.data_point_weight * pair.weight;
-
-    // Collisions between capsules of different fingers that are close now.
-    std::vector<CollisionPair> collisions;
-    for (size_t a = 0; a < data_->capsules.size(); ++a) {
-      for (size_t b = a + 1; b < data_->capsules.size(); ++b) {
-        const auto& ca = data_->capsules[a];
-        const auto& cb = data_->capsules[b];
-        if (ca.finger == cb.finger) continue;
-        const Rigid3& ta = cam_from_bone[ca.bone];
-        const Rigid3& tb = cam_from_bone[cb.bone];
-        double s, t;
-        ClosestPointsOfSegments(ta.translation(), ta * Eigen::Vector3d(ca.length, 0, 0),
-                                tb.translation(), tb * Eigen::Vector3d(cb.length, 0, 0), &s, &t);
-        const Eigen::Vector3d pa(s * ca.length, 0, 0), pb(t * cb.length, 0, 0);
-        if ((ta * pa - tb * pb).norm() > ca.radius + cb.radius + kCollisionMarginMm) continue;
-        collisions.push_back({ca.bone, pa, ca.radius, cb.bone, pb, cb.radius});
-      }
-    }
-
-    PoseParameters parameters(pose);
-    ceres::Problem problem;
-    problem.AddResidualBlock(new HandFitCost(model_, parameters.reference_rotation(), intrinsics_,
-                                             {std::move(model_pairs), std::move(data_pairs),
-                                              silhouette_pairs(), std::move(collisions)},
-                                             options_.collision_weight, options_.limit_weight,
-                                             options_.prior_weight, prior),
-                             nullptr, parameters.values().data());
-    ceres::Solver::Options solver;
-    // A few hundred residual rows, ≈ 30 parameters: the normal equations are small and cheap.
-    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-    solver.max_num_iterations = options_.inner_iterations;
-    solver.function_tolerance = options_.inner_function_tolerance;
-    // Correspondences hold only near the current pose: start with modest steps.
-    solver.initial_trust_region_radius = options_.initial_trust_radius;
-    solver.num_threads = 1;
-    solver.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
-    pose = parameters.ToPose();
+    if (d > options_.max_correspondence_mm) continue;
+    model_pairs.push_back(
+        {precomputed_.samples[i], data_tree_.points()[j].cast<double>(), HuberWeight(d)});
   }
+  return model_pairs;
+}
 
+// The nearest point, within unlabelled_match_mm, of the depth pixels around a model point's
+// image that neither mask holds (see HandFitOptions).
+double HandFitter::FitState::NearestUnlabelled(const Eigen::Vector3f& point,
+                                               Eigen::Vector3d* out) const {
+  if (options_.unlabelled_match_mm <= 0 || frame_ == nullptr || segmentation_ == nullptr ||
+      segmentation_->hand_mask.size() != frame_->depth_mm.size() ||
+      segmentation_->object_mask.size() != frame_->depth_mm.size()) {
+    return std::numeric_limits<double>::infinity();
+  }
+  constexpr int kRadiusPx = 2;
+  const Eigen::Vector3d p = point.cast<double>();
+  const Eigen::Vector2d pixel = intrinsics_.Project(p);
+  const int u0 = static_cast<int>(std::lround(pixel.x()));
+  const int v0 = static_cast<int>(std::lround(pixel.y()));
+  double best = options_.unlabelled_match_mm;
+  bool found = false;
+  for (int v = std::max(0, v0 - kRadiusPx); v <= std::min(frame_->height - 1, v0 + kRadiusPx);
+       ++v) {
+    for (int u = std::max(0, u0 - kRadiusPx); u <= std::min(frame_->width - 1, u0 + kRadiusPx);
+         ++u) {
+      const size_t at = static_cast<size_t>(v) * frame_->width + u;
+      const std::uint16_t z = frame_->depth_mm[at];
+      if (z == 0 || segmentation_->hand_mask[at] != 0 || segmentation_->object_mask[at] != 0) {
+        continue;
+      }
+      const Eigen::Vector3d q = intrinsics_.BackProject(u, v, z);
+      const double d = (q - p).norm();
+      if (d < best) {
+        best = d;
+        *out = q;
+        found = true;
+      }
+    }
+  }
+  return found ? best : std::numeric_limits<double>::infinity();
+}
+
+// Data → model: data points to the tangent plane of their nearest sample facing the camera.
+std::vector<PlanePair> HandFitter::FitState::DataToModelPairs() const {
+  const PointKdTree model_tree = FacingTree();
+  std::vector<PlanePair> data_pairs;
+  for (const Eigen::Vector3f& point : data_) {
+    float d2 = 0;
+    const int k = model_tree.Nearest(point, &d2);
+    const double d = std::sqrt(d2);
+    if (k < 0 || d > options_.max_correspondence_mm) continue;
+    const int i = facing_[k];
+    data_pairs.push_back(
+        {precomputed_.samples[i], point.cast<double>(), normals_[i], HuberWeight(d)});
+  }
+  return data_pairs;
+}
+
+// Weighs each direction's pairs as a mean over them, and gives the data → model pairs their
+// point weight.
+void HandFitter::FitState::WeighPairs(std::vector<PointPair>* model_pairs,
+                                      std::vector<PlanePair>* data_pairs) const {
+  // Each direction is a mean over its pairs.
+  const double model_scale =
+      model_pairs->empty() ? 0 : 1.0 / std::sqrt(double(model_pairs->size()));
+  for (PointPair& pair : *model_pairs) pair.weight *= model_scale;
+  const double data_scale = data_pairs->empty() ? 0 : 1.0 / std::sqrt(double(data_pairs->size()));
+  for (PlanePair& pair : *data_pairs) pair.weight *= data_scale;
+  // The data → model pairs also as points: a plane lets a finger slide along its axis.
+  for (PlanePair& pair : *data_pairs) pair.point_weight = options_.data_point_weight * pair.weight;
+}
+
+// Collisions between capsules of different fingers that are close now.
+std::vector<CollisionPair> HandFitter::FitState::CloseCollisions() const {
+  const auto& cam_from_bone = kinematics_.cam_from_bone();
+  const auto& capsules = precomputed_.capsules;
+  std::vector<CollisionPair> collisions;
+  for (size_t a = 0; a < capsules.size(); ++a) {
+    for (size_t b = a + 1; b < capsules.size(); ++b) {
+      const auto& ca = capsules[a];
+      const auto& cb = capsules[b];
+      if (ca.finger == cb.finger) continue;
+      const Rigid3& ta = cam_from_bone[ca.bone];
+      const Rigid3& tb = cam_from_bone[cb.bone];
+      double s, t;
+      ClosestPointsOfSegments(ta.translation(), ta * Eigen::Vector3d(ca.length, 0, 0),
+                              tb.translation(), tb * Eigen::Vector3d(cb.length, 0, 0), &s, &t);
+      const Eigen::Vector3d pa(s * ca.length, 0, 0), pb(t * cb.length, 0, 0);
+      if ((ta * pa - tb * pb).norm() > ca.radius + cb.radius + kCollisionMarginMm) continue;
+      collisions.push_back({ca.bone, pa, ca.radius, cb.bone, pb, cb.radius});
+    }
+  }
+  return collisions;
+}
+
+// Once the samples are posed at the initial pose: the silhouette, the region around the
+// model's image, and each of its pixels' nearest silhouette pixel.
+void HandFitter::FitState::PrepareSilhouette() {
+  silhouette_.resize(segmentation_->hand_mask.size());
+  for (size_t p = 0; p < silhouette_.size(); ++p)
+    silhouette_[p] = segmentation_->hand_mask[p] | segmentation_->object_mask[p];
+  roi_ = ModelImageRoi();
+  if (options_.unlabelled_match_mm > 0 && frame_ != nullptr &&
+      frame_->depth_mm.size() == silhouette_.size()) {
+    AddUnlabelledToSilhouette();
+  }
+  if (roi_[2] > roi_[0] && roi_[3] > roi_[1])
+    nearest_silhouette_ = NearestSetPixels(silhouette_, segmentation_->width, roi_);
+}
+
+// The region around the posed samples' image (x0, y0, x1, y1; exclusive ends), clipped to the
+// segmentation's image.
+std::array<int, 4> HandFitter::FitState::ModelImageRoi() const {
+  constexpr int kMarginPx = 40;
+  std::array<int, 4> roi = {segmentation_->width, segmentation_->height, 0, 0};
+  for (const Eigen::Vector3f& p : posed_) {
+    if (p.z() <= 1) continue;
+    const Eigen::Vector2d pixel = intrinsics_.Project(p.cast<double>());
+    roi[0] = std::min(roi[0], static_cast<int>(pixel.x()) - kMarginPx);
+    roi[1] = std::min(roi[1], static_cast<int>(pixel.y()) - kMarginPx);
+    roi[2] = std::max(roi[2], static_cast<int>(pixel.x()) + kMarginPx);
+    roi[3] = std::max(roi[3], static_cast<int>(pixel.y()) + kMarginPx);
+  }
+  return {std::max(0, roi[0]), std::max(0, roi[1]), std::min(segmentation_->width, roi[2]),
+          std::min(segmentation_->height, roi[3])};
+}
+
+// With unlabelled_match_mm, what the segmentation left out (depth in the crop volume) is
+// inside the silhouette too.
+void HandFitter::FitState::AddUnlabelledToSilhouette() {
+  for (int v = roi_[1]; v < roi_[3]; ++v) {
+    for (int u = roi_[0]; u < roi_[2]; ++u) {
+      const size_t at = static_cast<size_t>(v) * segmentation_->width + u;
+      if (silhouette_[at] || frame_->depth_mm[at] == 0) continue;
+      const Eigen::Vector3d x = intrinsics_.BackProject(u, v, frame_->depth_mm[at]);
+      silhouette_[at] = (x.array() >= options_.crop_min_mm.array()).all() &&
+                        (x.array() <= options_.crop_max_mm.array()).all();
+    }
+  }
+}
+
+// Silhouette pairs: model points (seen or not) in the crop volume whose image lies outside
+// the silhouette, pulled to within the tolerance of its nearest pixel. The wrist's points are
+// left out: where a scan of the forearm ends (sleeve, crop) says nothing about the hand.
+std::vector<SilhouettePair> HandFitter::FitState::SilhouettePairs() const {
+  std::vector<SilhouettePair> pairs;
+  if (nearest_silhouette_.empty()) return pairs;
+  int considered = 0;
+  const int roi_width = roi_[2] - roi_[0];
+  for (int i = 0; i < samples_; ++i) {
+    if (precomputed_.sample_bone[i] == 0) continue;
+    const Eigen::Vector3d p = posed_[i].cast<double>();
+    if (p.z() <= 1 || OutsideCrop(p)) continue;
+    ++considered;
+    const Eigen::Vector2d pixel = intrinsics_.Project(p);
+    const int u = static_cast<int>(std::lround(pixel.x()));
+    const int v = static_cast<int>(std::lround(pixel.y()));
+    if (u < roi_[0] || v < roi_[1] || u >= roi_[2] || v >= roi_[3]) continue;
+    const int site = nearest_silhouette_[(v - roi_[1]) * roi_width + (u - roi_[0])];
+    if (site < 0 || silhouette_[site] == 0) continue;
+    const Eigen::Vector2d target(site % segmentation_->width, site / segmentation_->width);
+    const double distance = (pixel - target).norm();
+    if (distance <= options_.silhouette_tolerance_px) continue;
+    const Eigen::Vector2d inside =
+        target + options_.silhouette_tolerance_px * (pixel - target) / distance;
+    pairs.push_back({precomputed_.samples[i], inside, p.z() / intrinsics_.fx});
+  }
+  const double scale =
+      considered == 0 ? 0 : options_.silhouette_weight / std::sqrt(double(considered));
+  for (SilhouettePair& pair : pairs) pair.weight *= scale;
+  return pairs;
+}
+
+// Solves the inner problem with `terms` from the current pose, which it then replaces.
+void HandFitter::FitState::Solve(HandFitTerms terms) {
+  PoseParameters parameters(pose_);
+  ceres::Problem problem;
+  problem.AddResidualBlock(new HandFitCost(model_, parameters.reference_rotation(), intrinsics_,
+                                           std::move(terms), options_.collision_weight,
+                                           options_.limit_weight, options_.prior_weight, prior_),
+                           nullptr, parameters.values().data());
+  ceres::Solver::Options solver;
+  // A few hundred residual rows, ≈ 30 parameters: the normal equations are small and cheap.
+  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = options_.inner_iterations;
+  solver.function_tolerance = options_.inner_function_tolerance;
+  // Correspondences hold only near the current pose: start with modest steps.
+  solver.initial_trust_region_radius = options_.initial_trust_radius;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  pose_ = parameters.ToPose();
+}
+
+HandFitResult HandFitter::FitState::Result() {
   // How well the final pose explains the data, and the data the model.
-  pose_samples(pose);
-  visible_samples = find_visible();
-  std::vector<Eigen::Vector3f> facing_points;
-  for (int i : facing) facing_points.push_back(posed[i]);
-  const PointKdTree model_tree(std::move(facing_points));
+  PoseSamples();
+  const std::vector<int> visible_samples = FindVisible();
+  const PointKdTree model_tree = FacingTree();
   double sum = 0;
   int covered = 0;
-  for (const Eigen::Vector3f& point : measured) {
+  for (const Eigen::Vector3f& point : measured_) {
     float d2 = 0;
     if (model_tree.Nearest(point, &d2) < 0) d2 = 1e6f;
     sum += std::sqrt(d2);
@@ -665,17 +627,33 @@ HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, c
   double model_sum = 0;
   for (int i : visible_samples) {
     float d2 = 0;
-    data_tree.Nearest(posed[i], &d2);
+    data_tree_.Nearest(posed_[i], &d2);
     visible_covered += std::sqrt(d2) <= kCoverageMm;
     model_sum += std::sqrt(d2);
   }
+  HandFitResult result;
+  result.pose = pose_;
+  result.data_points = static_cast<int>(data_.size());
   result.model_error_mm = visible_samples.empty() ? 0 : model_sum / visible_samples.size();
-  result.pose = pose;
-  result.data_error_mm = sum / measured.size();
-  result.data_coverage = static_cast<double>(covered) / measured.size();
+  result.data_error_mm = sum / measured_.size();
+  result.data_coverage = static_cast<double>(covered) / measured_.size();
   result.model_coverage =
       visible_samples.empty() ? 0 : static_cast<double>(visible_covered) / visible_samples.size();
   return result;
+}
+
+HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
+                              const HandPose& initial, const Segmentation* segmentation) const {
+  if (hand_points.empty()) {
+    HandFitResult result;
+    result.pose = initial;
+    return result;
+  }
+  FitState state(*this, hand_points, frame, initial, segmentation);
+  for (int outer = 0; outer < options_.outer_iterations; ++outer) {
+    if (!state.Iterate(outer == 0)) break;
+  }
+  return state.Result();
 }
 
 namespace {

@@ -128,6 +128,7 @@ class HandFitter {
 
  private:
   struct Data;
+  class FitState;  // One Fit call's state and steps (hand_fit.cc).
   const HandModel& model_;
   const CameraIntrinsics intrinsics_;
   const HandFitOptions options_;

@@ -1,6 +1,7 @@
 #pragma once
-// Internal to the tracker (included by hand_fit.cc and its test only, as it brings in Ceres): the
-// least-squares cost of one inner hand-fit problem, with analytic derivatives.
+// Internal to the tracker (included by hand_fit.cc, hand_fit_cost.cc and their test only, as it
+// brings in Ceres): the least-squares cost of one inner hand-fit problem, with analytic
+// derivatives.
 
 #include <ceres/ceres.h>
 
