@@ -21,14 +21,14 @@ void IcpOptions::Check() const {
 
 namespace {
 
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+
 // The part of a step in the directions `free` (columns of `basis`) that best meets the anchors
 // (normal equations `anchor_matrix`·x = `anchor_rhs`) given the rest of the step, `fixed`;
 // directions the anchors hardly know (under a millionth of their strongest) stay at zero.
-Eigen::Matrix<double, 6, 1> AnchorStep(const Eigen::Matrix<double, 6, 6>& basis,
-                                       const std::vector<int>& free,
-                                       const Eigen::Matrix<double, 6, 6>& anchor_matrix,
-                                       const Eigen::Matrix<double, 6, 1>& anchor_rhs,
-                                       const Eigen::Matrix<double, 6, 1>& fixed) {
+Vector6 AnchorStep(const Matrix6& basis, const std::vector<int>& free, const Matrix6& anchor_matrix,
+                   const Vector6& anchor_rhs, const Vector6& fixed) {
   const int k = static_cast<int>(free.size());
   Eigen::MatrixXd directions(6, k);
   for (int c = 0; c < k; ++c) directions.col(c) = basis.col(free[c]);
@@ -46,6 +46,314 @@ Eigen::Matrix<double, 6, 1> AnchorStep(const Eigen::Matrix<double, 6, 6>& basis,
   return directions * y;
 }
 
+// Whether `step` is small enough to end the iterations (it moves less than 0.01 mm).
+bool Converged(const Vector6& step) { return step.tail<3>().norm() + step.head<3>().norm() < 0.01; }
+
+// Normal equations of a Gauss–Newton step: matrix·step = rhs.
+struct Equations {
+  Matrix6 matrix = Matrix6::Zero();
+  Vector6 rhs = Vector6::Zero();
+};
+
+// A point's partner on the model: the surface seen through the point's nearest pixel.
+struct ModelPair {
+  int u = 0;
+  int v = 0;
+  size_t index = 0;
+  float depth = 0;
+  Eigen::Vector3d normal;
+  Eigen::Vector3d target;
+};
+
+// What the first iteration gathers about the model's normals, to keep the free directions:
+// where the normal lines meet (least squares: Σ(I − nnᵀ)·x = Σ(I − nnᵀ)·p) and their noise.
+struct NormalLines {
+  Eigen::Matrix3d across = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d across_points = Eigen::Vector3d::Zero();
+  std::vector<double> jitter;
+};
+
+// One AlignToModel call: its inputs and the state its iterations carry.
+class Aligner {
+ public:
+  Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
+          const CameraIntrinsics& intrinsics, const IcpOptions& options,
+          const std::vector<IcpAnchor>& anchors);
+
+  // Runs the Gauss–Newton iterations until they converge, fail or run out.
+  void Run();
+
+  const Rigid3& correction() const { return correction_; }
+  int inliers() const { return inliers_; }
+  double rms() const { return rms_; }
+  int iterations() const { return iterations_; }
+
+ private:
+  // One iteration; returns whether another may follow.
+  bool Iterate(int iteration);
+  // The point pairs' equations at the current correction (counts the inliers, sets the rms);
+  // with `lines`, also gathers the model's normal lines.
+  Equations PairPoints(NormalLines* lines);
+  // The model surface paired with `p` (current camera, corrected), if it is near enough.
+  bool FindPair(const Eigen::Vector3d& p, ModelPair* pair) const;
+  // Adds a pair's normal line and normal noise to `lines`.
+  void AddNormalLine(const Eigen::Vector3d& p, const ModelPair& pair, NormalLines* lines) const;
+  // Moves the pivot to where the normal lines meet, rewriting `surface` about it.
+  void MovePivot(const NormalLines& lines, Equations* surface);
+  // The normals' noise: the median of `jitter`, when there is any.
+  void MeasureNormalNoise(std::vector<double>* jitter);
+  // The anchors' equations, weighed against the iteration's inliers.
+  Equations AnchorEquations() const;
+  // The Jacobian row of a point `p` moved along `direction` by the twist about the centre.
+  Vector6 Row(const Eigen::Vector3d& p, const Eigen::Vector3d& direction) const;
+  // The step the (damped) equations ask for.
+  Vector6 Solve(Equations surface, const Equations& anchored) const;
+  // The step in the directions the surface constrains, the anchors' in the others.
+  Vector6 SolveConstrained(const Equations& surface, const Equations& anchored) const;
+  // Applies `step` (a twist about the centre) to the correction.
+  void ApplyStep(const Vector6& step);
+
+  const std::vector<Eigen::Vector3f>& points_;
+  const RaycastImage& model_;
+  const CameraIntrinsics& intrinsics_;
+  const IcpOptions& options_;
+  const std::vector<IcpAnchor>& anchors_;
+  const double max_sq_;
+  // predicted_from_current: takes the current camera's points to where the predicted camera
+  // sees the same surface (the model's raycast).
+  Rigid3 correction_;
+  double rms_ = 0;
+  int inliers_ = 0;
+  int iterations_ = 0;
+  // The twist is taken about a pivot (first the points' centroid), with the turn scaled by the
+  // points' spread about it, so that turns and shifts weigh alike.
+  Eigen::Vector3d pivot_;
+  double spread_sq_ = 0;
+  double scale_ = 1;
+  // The pivot as the correction moves it, in this iteration.
+  Eigen::Vector3d centre_;
+  // Without anchors (or with anchors for them alone), the directions the surface leaves free
+  // keep the prediction (IcpOptions::min_constraint_over_noise, anchors_free_directions_only).
+  bool keep_free_ = false;
+  // What a direction of the motion learns per point pair from the model's normal noise alone.
+  double noise_information_ = 0;
+};
+
+Aligner::Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
+                 const CameraIntrinsics& intrinsics, const IcpOptions& options,
+                 const std::vector<IcpAnchor>& anchors)
+    : points_(points),
+      model_(model),
+      intrinsics_(intrinsics),
+      options_(options),
+      anchors_(anchors),
+      max_sq_(options.max_distance_mm * options.max_distance_mm) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& point : points) centroid += point.cast<double>();
+  centroid /= std::max<size_t>(1, points.size());
+  for (const Eigen::Vector3f& point : points)
+    spread_sq_ += (point.cast<double>() - centroid).squaredNorm();
+  spread_sq_ /= std::max<size_t>(1, points.size());
+  pivot_ = centroid;
+  scale_ = std::max(1.0, std::sqrt(spread_sq_));
+  keep_free_ = (anchors.empty() || options.anchors_free_directions_only) &&
+               options.min_constraint_over_noise > 0;
+}
+
+void Aligner::Run() {
+  for (int iteration = 0; iteration < options_.iterations; ++iteration) {
+    if (!Iterate(iteration)) break;
+  }
+}
+
+bool Aligner::Iterate(int iteration) {
+  centre_ = correction_ * pivot_;
+  const bool find_pivot = keep_free_ && iteration == 0;
+  NormalLines lines;
+  Equations surface = PairPoints(find_pivot ? &lines : nullptr);
+  if (find_pivot && inliers_ >= 6) {
+    MovePivot(lines, &surface);
+    MeasureNormalNoise(&lines.jitter);
+  }
+  const Equations anchored = AnchorEquations();
+  if (!keep_free_) {
+    surface.matrix += anchored.matrix;
+    surface.rhs += anchored.rhs;
+  }
+  if (inliers_ < 6) return false;
+  const Vector6 step = Solve(std::move(surface), anchored);
+  if (!step.allFinite()) return false;
+  ApplyStep(step);
+  iterations_ = iteration + 1;
+  return !Converged(step);
+}
+
+Equations Aligner::PairPoints(NormalLines* lines) {
+  Equations surface;
+  if (lines) lines->jitter.reserve(points_.size());
+  double sum_sq = 0;
+  inliers_ = 0;
+  for (const Eigen::Vector3f& point : points_) {
+    const Eigen::Vector3d p = correction_ * Eigen::Vector3d(point.cast<double>());
+    ModelPair pair;
+    if (!FindPair(p, &pair)) continue;
+    const double residual = pair.normal.dot(p - pair.target);
+    // d(residual)/d(θ, t) for p ← exp(θ / scale)·(p − c) + c + t: ((p − c) / scale × n, n).
+    const Vector6 row = Row(p, pair.normal);
+    // The upper triangle only; the lower one is filled in once per iteration.
+    for (int c = 0; c < 6; ++c) surface.matrix.col(c).head(c + 1) += row[c] * row.head(c + 1);
+    surface.rhs -= row * residual;
+    sum_sq += residual * residual;
+    ++inliers_;
+    if (lines) AddNormalLine(p, pair, lines);
+  }
+  surface.matrix.triangularView<Eigen::StrictlyLower>() = surface.matrix.transpose();
+  rms_ = inliers_ > 0 ? std::sqrt(sum_sq / inliers_) : 0;
+  return surface;
+}
+
+bool Aligner::FindPair(const Eigen::Vector3d& p, ModelPair* pair) const {
+  if (p.z() <= 0) return false;
+  const Eigen::Vector2d pixel = intrinsics_.Project(p);
+  // The nearest pixel (inside the image, truncation rounds).
+  if (!intrinsics_.Contains(pixel.x(), pixel.y())) return false;
+  pair->u = static_cast<int>(pixel.x() + 0.5);
+  pair->v = static_cast<int>(pixel.y() + 0.5);
+  pair->index = static_cast<size_t>(pair->v) * model_.width + pair->u;
+  pair->depth = model_.depth_mm[pair->index];
+  pair->normal = model_.normals[pair->index].cast<double>();
+  if (pair->depth <= 0 || pair->normal.squaredNorm() < 0.5) return false;
+  pair->target = intrinsics_.BackProject(pair->u, pair->v, pair->depth);
+  return !((p - pair->target).squaredNorm() > max_sq_);
+}
+
+void Aligner::AddNormalLine(const Eigen::Vector3d& p, const ModelPair& pair,
+                            NormalLines* lines) const {
+  // The model's normal noise: half the squared difference to the next pixel's normal on the
+  // same surface.
+  const size_t next = pair.index + 1;
+  if (pair.u + 1 < model_.width && model_.depth_mm[next] > 0 &&
+      std::abs(model_.depth_mm[next] - pair.depth) < 2 * options_.max_distance_mm) {
+    lines->jitter.push_back(0.5 *
+                            (model_.normals[next].cast<double>() - pair.normal).squaredNorm());
+  }
+  const Eigen::Matrix3d off_normal =
+      Eigen::Matrix3d::Identity() - pair.normal * pair.normal.transpose();
+  lines->across += off_normal;
+  lines->across_points += off_normal * p;
+}
+
+void Aligner::MovePivot(const NormalLines& lines, Equations* surface) {
+  // The surface's free turns (a sphere's, a bottle's about its axis) are turns about where
+  // its normal lines meet: taken about that point, they are pure turns, so keeping them at the
+  // prediction does not turn the object when its position is corrected. Where the lines do
+  // not meet (a plane), the pivot stays near the centroid.
+  const double pull = 1e-3 * lines.across.trace();
+  const Eigen::Vector3d meet = (lines.across + pull * Eigen::Matrix3d::Identity())
+                                   .ldlt()
+                                   .solve(lines.across_points + pull * centre_);
+  if (!meet.allFinite() || !((meet - centre_).norm() < 3 * scale_)) return;
+  // Rows about the new pivot are T·rows: ((p − c′) × n) / s′ = (s/s′)·((p − c) × n) / s
+  // + ((c − c′) × n) / s′.
+  const double new_scale = std::max(1.0, std::sqrt(spread_sq_ + (meet - centre_).squaredNorm()));
+  Matrix6 to_pivot = Matrix6::Identity();
+  to_pivot.topLeftCorner<3, 3>() *= scale_ / new_scale;
+  const Eigen::Vector3d d = centre_ - meet;
+  to_pivot.topRightCorner<3, 3>() << 0, -d.z(), d.y(), d.z(), 0, -d.x(), -d.y(), d.x(), 0;
+  to_pivot.topRightCorner<3, 3>() /= new_scale;
+  surface->matrix = to_pivot * surface->matrix * to_pivot.transpose();
+  surface->rhs = to_pivot * surface->rhs;
+  pivot_ = meet;  // The correction is the identity in the first iteration.
+  centre_ = meet;
+  scale_ = new_scale;
+}
+
+void Aligner::MeasureNormalNoise(std::vector<double>* jitter) {
+  if (jitter->empty()) return;
+  auto middle = jitter->begin() + jitter->size() / 2;
+  std::nth_element(jitter->begin(), middle, jitter->end());
+  noise_information_ = *middle;
+}
+
+Equations Aligner::AnchorEquations() const {
+  // The anchors together weigh `anchor_share` of the surface's pairs: they decide what the
+  // surface leaves open (a sphere's turn) and hardly move what it fixes.
+  double anchor_total = 0;
+  for (const IcpAnchor& anchor : anchors_) anchor_total += anchor.weight;
+  const double anchor_scale =
+      anchor_total > 0 ? options_.anchor_share * std::max(inliers_, 1) / anchor_total : 0.0;
+  Equations anchored;
+  for (const IcpAnchor& anchor : anchors_) {
+    const double weight = anchor.weight * anchor_scale;
+    const Eigen::Vector3d p = correction_ * anchor.current;
+    const Eigen::Vector3d residual = p - anchor.target;
+    for (int k = 0; k < 3; ++k) {
+      const Vector6 row = Row(p, Eigen::Vector3d::Unit(k));
+      anchored.matrix += weight * row * row.transpose();
+      anchored.rhs -= weight * row * residual[k];
+    }
+  }
+  return anchored;
+}
+
+Vector6 Aligner::Row(const Eigen::Vector3d& p, const Eigen::Vector3d& direction) const {
+  Vector6 row;
+  row << ((p - centre_) / scale_).cross(direction), direction;
+  return row;
+}
+
+Vector6 Aligner::Solve(Equations surface, const Equations& anchored) const {
+  // A little (Marquardt) damping keeps directions the data do not constrain at all where the
+  // prediction put them.
+  surface.matrix.diagonal() *= 1.0 + 1e-4;
+  surface.matrix.diagonal().array() += 1e-9;
+  if (keep_free_ && noise_information_ > 0) return SolveConstrained(surface, anchored);
+  if (keep_free_) {
+    // No measure of the normals' noise to tell free directions by: the anchors join in.
+    return (surface.matrix + anchored.matrix).ldlt().solve(surface.rhs + anchored.rhs);
+  }
+  return surface.matrix.ldlt().solve(surface.rhs);
+}
+
+Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anchored) const {
+  // Only the directions the surface constrains move; the others keep the prediction, or
+  // follow the anchors where they have any.
+  const Eigen::SelfAdjointEigenSolver<Matrix6> eigen(surface.matrix);
+  const double floor = options_.min_constraint_over_noise * noise_information_ * inliers_;
+  Vector6 step = Vector6::Zero();
+  std::vector<int> free;
+  for (int i = 0; i < 6; ++i) {
+    const double value = eigen.eigenvalues()[i];
+    if (value <= floor || value <= 0) {
+      free.push_back(i);
+      continue;
+    }
+    const auto direction = eigen.eigenvectors().col(i);
+    step += direction * (direction.dot(surface.rhs) / value);
+  }
+  if (!free.empty() && !anchors_.empty())
+    step += AnchorStep(eigen.eigenvectors(), free, anchored.matrix, anchored.rhs, step);
+  return step;
+}
+
+void Aligner::ApplyStep(const Vector6& step) {
+  const Rigid3 turn = Rigid3::FromRotationVector(step.head<3>() / scale_, Eigen::Vector3d::Zero());
+  correction_ = Rigid3::Translation(centre_ + step.tail<3>()) * turn *
+                Rigid3::Translation(-centre_) * correction_;
+}
+
+// Accepts `result` when at least `needed` of the `point_count` points paired with the model,
+// else says why not.
+void CheckEnoughPairs(int needed, size_t point_count, IcpResult* result) {
+  if (result->inliers < needed) {
+    result->reason = "ICP: " + std::to_string(result->inliers) + " of " +
+                     std::to_string(point_count) + " points pair with the model (need " +
+                     std::to_string(needed) + ")";
+    return;
+  }
+  result->ok = true;
+}
+
 }  // namespace
 
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
@@ -55,184 +363,17 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   IHS_CHECK_ARG(model.width == intrinsics.width && model.height == intrinsics.height,
                 "the raycast is " << model.width << "x" << model.height << ", the camera "
                                   << intrinsics.width << "x" << intrinsics.height);
-  IcpResult result;
-  result.cam_from_volume = predicted;
   const int needed =
       std::max(50, static_cast<int>(std::ceil(options.min_inlier_fraction * points.size())));
-  // predicted_from_current: takes the current camera's points to where the predicted camera
-  // sees the same surface (the model's raycast).
-  Rigid3 correction;
-  const double max_sq = options.max_distance_mm * options.max_distance_mm;
-  double rms = 0;
-  int inliers = 0;
-  // The twist is taken about a pivot (first the points' centroid), with the turn scaled by the
-  // points' spread about it, so that turns and shifts weigh alike.
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& point : points) centroid += point.cast<double>();
-  centroid /= std::max<size_t>(1, points.size());
-  double spread_sq = 0;
-  for (const Eigen::Vector3f& point : points)
-    spread_sq += (point.cast<double>() - centroid).squaredNorm();
-  spread_sq /= std::max<size_t>(1, points.size());
-  Eigen::Vector3d pivot = centroid;
-  double scale = std::max(1.0, std::sqrt(spread_sq));
-  // Without anchors (or with anchors for them alone), the directions the surface leaves free keep
-  // the prediction (IcpOptions::min_constraint_over_noise, anchors_free_directions_only).
-  const bool keep_free = (anchors.empty() || options.anchors_free_directions_only) &&
-                         options.min_constraint_over_noise > 0;
-  std::vector<double> normal_jitter;
-  // What a direction of the motion learns per point pair from the model's normal noise alone.
-  double noise_information = 0;
-  for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Vector3d centre = correction * pivot;
-    // Where the model's normal lines meet (least squares): Σ(I − nnᵀ)·x = Σ(I − nnᵀ)·p.
-    const bool find_pivot = keep_free && iteration == 0;
-    Eigen::Matrix3d across = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d across_points = Eigen::Vector3d::Zero();
-    if (find_pivot) normal_jitter.reserve(points.size());
-    double sum_sq = 0;
-    inliers = 0;
-    for (const Eigen::Vector3f& point : points) {
-      const Eigen::Vector3d p = correction * Eigen::Vector3d(point.cast<double>());
-      if (p.z() <= 0) continue;
-      const Eigen::Vector2d pixel = intrinsics.Project(p);
-      // The nearest pixel (inside the image, truncation rounds).
-      if (!intrinsics.Contains(pixel.x(), pixel.y())) continue;
-      const int u = static_cast<int>(pixel.x() + 0.5), v = static_cast<int>(pixel.y() + 0.5);
-      const size_t index = static_cast<size_t>(v) * model.width + u;
-      const float depth = model.depth_mm[index];
-      const Eigen::Vector3d normal = model.normals[index].cast<double>();
-      if (depth <= 0 || normal.squaredNorm() < 0.5) continue;
-      const Eigen::Vector3d target = intrinsics.BackProject(u, v, depth);
-      if ((p - target).squaredNorm() > max_sq) continue;
-      const double residual = normal.dot(p - target);
-      // d(residual)/d(θ, t) for p ← exp(θ / scale)·(p − c) + c + t: ((p − c) / scale × n, n).
-      Eigen::Matrix<double, 6, 1> row;
-      row << ((p - centre) / scale).cross(normal), normal;
-      // The upper triangle only; the lower one is filled in once per iteration.
-      for (int c = 0; c < 6; ++c) normal_matrix.col(c).head(c + 1) += row[c] * row.head(c + 1);
-      rhs -= row * residual;
-      sum_sq += residual * residual;
-      ++inliers;
-      if (find_pivot) {
-        // The model's normal noise: half the squared difference to the next pixel's normal on
-        // the same surface.
-        const size_t next = index + 1;
-        if (u + 1 < model.width && model.depth_mm[next] > 0 &&
-            std::abs(model.depth_mm[next] - depth) < 2 * options.max_distance_mm) {
-          normal_jitter.push_back(0.5 *
-                                  (model.normals[next].cast<double>() - normal).squaredNorm());
-        }
-        const Eigen::Matrix3d off_normal =
-            Eigen::Matrix3d::Identity() - normal * normal.transpose();
-        across += off_normal;
-        across_points += off_normal * p;
-      }
-    }
-    normal_matrix.triangularView<Eigen::StrictlyLower>() = normal_matrix.transpose();
-    if (find_pivot && inliers >= 6) {
-      // The surface's free turns (a sphere's, a bottle's about its axis) are turns about where
-      // its normal lines meet: taken about that point, they are pure turns, so keeping them at the
-      // prediction does not turn the object when its position is corrected. Where the lines do
-      // not meet (a plane), the pivot stays near the centroid.
-      const double pull = 1e-3 * across.trace();
-      const Eigen::Vector3d meet =
-          (across + pull * Eigen::Matrix3d::Identity()).ldlt().solve(across_points + pull * centre);
-      if (meet.allFinite() && (meet - centre).norm() < 3 * scale) {
-        // Rows about the new pivot are T·rows: ((p − c′) × n) / s′ = (s/s′)·((p − c) × n) / s
-        // + ((c − c′) × n) / s′.
-        const double new_scale =
-            std::max(1.0, std::sqrt(spread_sq + (meet - centre).squaredNorm()));
-        Eigen::Matrix<double, 6, 6> to_pivot = Eigen::Matrix<double, 6, 6>::Identity();
-        to_pivot.topLeftCorner<3, 3>() *= scale / new_scale;
-        const Eigen::Vector3d d = centre - meet;
-        to_pivot.topRightCorner<3, 3>() << 0, -d.z(), d.y(), d.z(), 0, -d.x(), -d.y(), d.x(), 0;
-        to_pivot.topRightCorner<3, 3>() /= new_scale;
-        normal_matrix = to_pivot * normal_matrix * to_pivot.transpose();
-        rhs = to_pivot * rhs;
-        pivot = meet;  // The correction is the identity in the first iteration.
-        centre = meet;
-        scale = new_scale;
-      }
-      if (!normal_jitter.empty()) {
-        auto middle = normal_jitter.begin() + normal_jitter.size() / 2;
-        std::nth_element(normal_jitter.begin(), middle, normal_jitter.end());
-        noise_information = *middle;
-      }
-    }
-    rms = inliers > 0 ? std::sqrt(sum_sq / inliers) : 0;
-    // The anchors together weigh `anchor_share` of the surface's pairs: they decide what the
-    // surface leaves open (a sphere's turn) and hardly move what it fixes.
-    double anchor_total = 0;
-    for (const IcpAnchor& anchor : anchors) anchor_total += anchor.weight;
-    const double anchor_scale =
-        anchor_total > 0 ? options.anchor_share * std::max(inliers, 1) / anchor_total : 0.0;
-    Eigen::Matrix<double, 6, 6> anchor_matrix = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> anchor_rhs = Eigen::Matrix<double, 6, 1>::Zero();
-    for (const IcpAnchor& anchor : anchors) {
-      const double weight = anchor.weight * anchor_scale;
-      const Eigen::Vector3d p = correction * anchor.current;
-      const Eigen::Vector3d residual = p - anchor.target;
-      for (int k = 0; k < 3; ++k) {
-        Eigen::Matrix<double, 6, 1> row;
-        row << ((p - centre) / scale).cross(Eigen::Vector3d::Unit(k)), Eigen::Vector3d::Unit(k);
-        anchor_matrix += weight * row * row.transpose();
-        anchor_rhs -= weight * row * residual[k];
-      }
-    }
-    if (!keep_free) {
-      normal_matrix += anchor_matrix;
-      rhs += anchor_rhs;
-    }
-    if (inliers < 6) break;
-    // A little (Marquardt) damping keeps directions the data do not constrain at all where the
-    // prediction put them.
-    normal_matrix.diagonal() *= 1.0 + 1e-4;
-    normal_matrix.diagonal().array() += 1e-9;
-    Eigen::Matrix<double, 6, 1> step;
-    if (keep_free && noise_information > 0) {
-      // Only the directions the surface constrains move; the others keep the prediction, or
-      // follow the anchors where they have any.
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(normal_matrix);
-      const double floor = options.min_constraint_over_noise * noise_information * inliers;
-      step.setZero();
-      std::vector<int> free;
-      for (int i = 0; i < 6; ++i) {
-        const double value = eigen.eigenvalues()[i];
-        if (value <= floor || value <= 0) {
-          free.push_back(i);
-          continue;
-        }
-        const auto direction = eigen.eigenvectors().col(i);
-        step += direction * (direction.dot(rhs) / value);
-      }
-      if (!free.empty() && !anchors.empty())
-        step += AnchorStep(eigen.eigenvectors(), free, anchor_matrix, anchor_rhs, step);
-    } else if (keep_free) {
-      // No measure of the normals' noise to tell free directions by: the anchors join in.
-      step = (normal_matrix + anchor_matrix).ldlt().solve(rhs + anchor_rhs);
-    } else {
-      step = normal_matrix.ldlt().solve(rhs);
-    }
-    if (!step.allFinite()) break;
-    const Rigid3 turn = Rigid3::FromRotationVector(step.head<3>() / scale, Eigen::Vector3d::Zero());
-    correction = Rigid3::Translation(centre + step.tail<3>()) * turn *
-                 Rigid3::Translation(-centre) * correction;
-    result.iterations = iteration + 1;
-    if (step.tail<3>().norm() + step.head<3>().norm() < 0.01) break;
-  }
-  result.inliers = inliers;
-  result.rms_mm = rms;
+  Aligner aligner(points, model, intrinsics, options, anchors);
+  aligner.Run();
+  IcpResult result;
+  result.iterations = aligner.iterations();
+  result.inliers = aligner.inliers();
+  result.rms_mm = aligner.rms();
   // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.
-  result.cam_from_volume = correction.Inverse() * predicted;
-  if (inliers < needed) {
-    result.reason = "ICP: " + std::to_string(inliers) + " of " + std::to_string(points.size()) +
-                    " points pair with the model (need " + std::to_string(needed) + ")";
-    return result;
-  }
-  result.ok = true;
+  result.cam_from_volume = aligner.correction().Inverse() * predicted;
+  CheckEnoughPairs(needed, points.size(), &result);
   return result;
 }
 

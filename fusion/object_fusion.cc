@@ -124,157 +124,29 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const auto started_at = SteadyClock::now();
   IHS_CHECK_ARG(input.frame != nullptr && input.object_mask != nullptr,
                 "Fuse needs a frame and its object mask");
-  const Frame& frame = *input.frame;
-  const std::vector<std::uint8_t>& mask = *input.object_mask;
-  IHS_CHECK_ARG(mask.size() == frame.depth_mm.size(), "the object mask does not fit the frame");
+  IHS_CHECK_ARG(input.object_mask->size() == input.frame->depth_mm.size(),
+                "the object mask does not fit the frame");
   FusionResult result;
   result.cam_from_object = cam_from_object_;
   auto finish = [&](FusionStatus status, std::string reason = {}) {
-    result.status = status;
-    result.reason = std::move(reason);
-    // The hand of a registered frame, for the next frame's model contacts (kept only when they
-    // are looked for: a copy of every vertex each frame).
-    if (options_.model_contacts.enabled && status != FusionStatus::kSkipped &&
-        input.hand) {
-      previous_hand_ = input.hand->vertices;
-    } else {
-      previous_hand_.clear();
-    }
-    // The object frame's origin is the first frame's object points' centroid: within a few cm
-    // of the object's centre, a few degrees of the direction to a camera half a metre away.
-    if (status != FusionStatus::kSkipped) coverage_.Observe(result.cam_from_object, {0, 0, 0});
-    result.coverage = coverage_.Share();
-    result.milliseconds = MillisecondsSince(started_at);
-    return std::move(result);
+    return Finish(input, started_at, status, std::move(reason), &result);
   };
-
-  // The object's points and where they are in the image.
-  std::vector<Eigen::Vector3f> points;
-  std::array<int, 4> box = {frame.width, frame.height, 0, 0};
-  for (int v = 0; v < frame.height; ++v) {
-    for (int u = 0; u < frame.width; ++u) {
-      const int pixel = v * frame.width + u;
-      if (!mask[pixel] || frame.depth_mm[pixel] == 0) continue;
-      points.push_back(intrinsics_.BackProject(u, v, frame.depth_mm[pixel]).cast<float>());
-      box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u + 1),
-             std::max(box[3], v + 1)};
-    }
-  }
-  if (static_cast<int>(points.size()) < options_.min_object_points) {
+  const ObjectPixels object = FindObject(*input.frame, *input.object_mask);
+  if (static_cast<int>(object.points.size()) < options_.min_object_points) {
     return finish(FusionStatus::kSkipped,
-                  "too few object points: " + std::to_string(points.size()) + " (need " +
+                  "too few object points: " + std::to_string(object.points.size()) + " (need " +
                       std::to_string(options_.min_object_points) + ")");
   }
-
   if (!started_) {
-    // The volume around the object: centred on its points, axes the camera's.
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const auto& p : points) centre += p.cast<double>();
-    centre /= static_cast<double>(points.size());
-    cam_from_object_ = Rigid3::Translation(centre);
-    result.cam_from_object = cam_from_object_;
-    const auto integrate_start = SteadyClock::now();
-    result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, cam_from_object_);
-    result.integrate_ms = MillisecondsSince(integrate_start);
-    free_space_.Observe(frame, box, cam_from_object_, input.hand);
-    started_ = true;
+    Start(input, object, &result);
     return finish(FusionStatus::kStarted);
   }
 
   // The correspondences' motion, then ICP from there.
-  Rigid3 pose = cam_from_object_;
-  const auto pairwise_start = SteadyClock::now();
-  // The contact sets as one, with the model's contacts and the anchors.
-  PairwiseInput correspondences;
   std::vector<PointMatch> contacts;
-  for (const MatchSet& set : input.correspondences.sets) {
-    if (set.kind == MatchKind::kVisual) correspondences.sets.push_back(set);
-    if (set.kind == MatchKind::kContact) {
-      contacts.insert(contacts.end(), set.pairs.begin(), set.pairs.end());
-    }
-  }
-  result.model_contacts = AddModelContacts(input, &contacts);
-  result.anchored_contacts = ApplyAnchors(&contacts);
-  correspondences.sets.push_back({"contacts", MatchKind::kContact, contacts});
-  result.pairwise = RegisterPair(correspondences, options_.pairwise);
-  result.pairwise_ms = MillisecondsSince(pairwise_start);
-  if (result.pairwise.ok) pose = result.pairwise.current_from_previous * cam_from_object_;
+  Rigid3 pose = Register(input, &contacts, &result);
   if (options_.use_icp) {
-    // The model where the object's points are, grown by what ICP can still pair them over
-    // (a point moves by less than that between ICP's start and its end).
-    const int margin = static_cast<int>(std::ceil(
-        2 * options_.icp.max_distance_mm * intrinsics_.fx / std::max(1.0, pose.translation().z())));
-    const std::array<int, 4> roi = {box[0] - margin, box[1] - margin, box[2] + margin,
-                                    box[3] + margin};
-    // The contacts, where the registration moved them (where it did not, where they were),
-    // hold ICP where the surface cannot (FusionOptions::icp_contacts_need_spread).
-    std::vector<IcpAnchor> anchors;
-    const bool spread =
-        result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm;
-    if (options_.pairwise.contact_weight > 0 &&
-        static_cast<int>(contacts.size()) >= options_.pairwise.min_contacts &&
-        (!options_.icp_contacts_need_spread || (result.pairwise.ok && spread))) {
-      const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
-      const double inlier_sq = options_.pairwise.inlier_mm * options_.pairwise.inlier_mm;
-      for (const PointMatch& contact : contacts) {
-        // Where feature matches fixed the motion, a contact they contradict is a mistracked
-        // fingertip (see PairwiseOptions::check_contacts): it must not steer what the surface
-        // leaves free and the features saw (a flat face's sliding). This is checked against the
-        // registered motion (features and contacts), not RegisterPair's features-only one: it
-        // also drops contacts that disagree with the other fingertips (taking RegisterPair's
-        // verdict instead raised the pin session's pairwise error from 0.55 to 0.60 mm).
-        if (options_.pairwise.check_contacts && result.pairwise.visual_inliers > 0 &&
-            (predicted_step * contact.previous - contact.current).squaredNorm() > inlier_sq) {
-          continue;
-        }
-        anchors.push_back(
-            {contact.current, predicted_step * contact.previous, options_.pairwise.contact_weight});
-      }
-    }
-    // The model is needed only near the object's points: rays start a little in front of them.
-    std::vector<std::uint16_t>& near = near_depth_;
-    near.assign(frame.depth_mm.size(), 0);
-    for (int v = std::max(0, box[1]); v < box[3]; ++v) {
-      for (int u = std::max(0, box[0]); u < box[2]; ++u) {
-        const int pixel = v * frame.width + u;
-        if (mask[pixel]) near[pixel] = frame.depth_mm[pixel];
-      }
-    }
-    const float window =
-        static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
-    IcpOptions icp_options = options_.icp;
-    // Contacts that fix a point but hardly a turn decide only what the surface leaves free.
-    icp_options.anchors_free_directions_only = !spread;
-    if (options_.contact_noise_reference_mm > 0 && contact_noise_mm_ > 0) {
-      const double ratio = options_.contact_noise_reference_mm / contact_noise_mm_;
-      icp_options.anchor_share *= std::clamp(ratio * ratio, 0.01, 100.0);
-    }
-    result.contact_noise_mm = contact_noise_mm_;
-    auto align = [&](const Rigid3& predicted, const std::vector<IcpAnchor>& with) {
-      const auto raycast_start = SteadyClock::now();
-      volume_.Raycast(intrinsics_, predicted, roi, &near, window, &model_image_);
-      const RaycastImage& model = model_image_;
-      result.raycast_ms += MillisecondsSince(raycast_start);
-      const auto icp_start = SteadyClock::now();
-      IcpResult icp = AlignToModel(points, model, intrinsics_, predicted, icp_options, with);
-      result.icp_ms += MillisecondsSince(icp_start);
-      return icp;
-    };
-    result.icp_anchors = static_cast<int>(anchors.size());
-    result.icp = align(pose, anchors);
-    // A registration that lands far off (a bad contact, a slipped finger) leaves ICP few pairs;
-    // from where the object was, it may find more.
-    const double paired = static_cast<double>(result.icp.inliers) / points.size();
-    if (result.pairwise.ok && (!result.icp.ok || paired < options_.icp_retry_fraction)) {
-      IcpResult retry = align(cam_from_object_, {});
-      if (retry.ok && retry.inliers > 1.2 * result.icp.inliers) {
-        result.icp = std::move(retry);
-        result.icp_from_previous = true;
-      }
-    }
-    if (result.icp.ok) {
-      pose = result.icp.cam_from_volume;
-    } else if (!result.pairwise.ok) {
+    if (!Refine(object, contacts, &pose, &result)) {
       return finish(FusionStatus::kSkipped,
                     "no registration: " + result.pairwise.reason + "; " + result.icp.reason);
     }
@@ -282,40 +154,224 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     return finish(FusionStatus::kSkipped, "no registration: " + result.pairwise.reason);
   }
 
-  // A plausible step from the previous pose?
   const Rigid3 step = pose * cam_from_object_.Inverse();
+  if (std::string jump = ImplausibleJump(pose, step); !jump.empty()) {
+    return finish(FusionStatus::kSkipped, std::move(jump));
+  }
+  UpdateContactNoise(contacts, step, &result);
+  Integrate(input, object, pose, &result);
+  UpdateAnchors(contacts, pose);
+  return finish(FusionStatus::kFused);
+}
+
+FusionResult ObjectFusion::Finish(const FusionInput& input, SteadyClock::time_point started_at,
+                                  FusionStatus status, std::string reason, FusionResult* result) {
+  result->status = status;
+  result->reason = std::move(reason);
+  // The hand of a registered frame, for the next frame's model contacts (kept only when they
+  // are looked for: a copy of every vertex each frame).
+  if (options_.model_contacts.enabled && status != FusionStatus::kSkipped && input.hand) {
+    previous_hand_ = input.hand->vertices;
+  } else {
+    previous_hand_.clear();
+  }
+  // The object frame's origin is the first frame's object points' centroid: within a few cm
+  // of the object's centre, a few degrees of the direction to a camera half a metre away.
+  if (status != FusionStatus::kSkipped) coverage_.Observe(result->cam_from_object, {0, 0, 0});
+  result->coverage = coverage_.Share();
+  result->milliseconds = MillisecondsSince(started_at);
+  return std::move(*result);
+}
+
+ObjectFusion::ObjectPixels ObjectFusion::FindObject(const Frame& frame,
+                                                    const std::vector<std::uint8_t>& mask) const {
+  // The object's points and where they are in the image.
+  ObjectPixels object{frame, mask, {}, {frame.width, frame.height, 0, 0}};
+  std::array<int, 4>& box = object.box;
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const int pixel = v * frame.width + u;
+      if (!mask[pixel] || frame.depth_mm[pixel] == 0) continue;
+      object.points.push_back(intrinsics_.BackProject(u, v, frame.depth_mm[pixel]).cast<float>());
+      box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u + 1),
+             std::max(box[3], v + 1)};
+    }
+  }
+  return object;
+}
+
+void ObjectFusion::Start(const FusionInput& input, const ObjectPixels& object,
+                         FusionResult* result) {
+  // The volume around the object: centred on its points, axes the camera's.
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : object.points) centre += p.cast<double>();
+  centre /= static_cast<double>(object.points.size());
+  Integrate(input, object, Rigid3::Translation(centre), result);
+  started_ = true;
+}
+
+void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& object,
+                             const Rigid3& pose, FusionResult* result) {
+  cam_from_object_ = pose;
+  result->cam_from_object = pose;
+  const auto integrate_start = SteadyClock::now();
+  result->integrated_voxels = volume_.Integrate(object.frame, object.mask, intrinsics_, pose);
+  result->integrate_ms = MillisecondsSince(integrate_start);
+  free_space_.Observe(object.frame, object.box, pose, input.hand);
+}
+
+Rigid3 ObjectFusion::Register(const FusionInput& input, std::vector<PointMatch>* contacts,
+                              FusionResult* result) const {
+  Rigid3 pose = cam_from_object_;
+  const auto pairwise_start = SteadyClock::now();
+  // The contact sets as one, with the model's contacts and the anchors.
+  PairwiseInput correspondences;
+  for (const MatchSet& set : input.correspondences.sets) {
+    if (set.kind == MatchKind::kVisual) correspondences.sets.push_back(set);
+    if (set.kind == MatchKind::kContact) {
+      contacts->insert(contacts->end(), set.pairs.begin(), set.pairs.end());
+    }
+  }
+  result->model_contacts = AddModelContacts(input, contacts);
+  result->anchored_contacts = ApplyAnchors(contacts);
+  correspondences.sets.push_back({"contacts", MatchKind::kContact, *contacts});
+  result->pairwise = RegisterPair(correspondences, options_.pairwise);
+  result->pairwise_ms = MillisecondsSince(pairwise_start);
+  if (result->pairwise.ok) pose = result->pairwise.current_from_previous * cam_from_object_;
+  return pose;
+}
+
+bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMatch>& contacts,
+                          Rigid3* pose, FusionResult* result) {
+  const IcpSetup setup = PrepareIcp(object, *pose, *result);
+  // The contacts, where the registration moved them (where it did not, where they were),
+  // hold ICP where the surface cannot (FusionOptions::icp_contacts_need_spread).
+  const std::vector<IcpAnchor> anchors = ContactAnchors(contacts, *pose, *result);
+  result->contact_noise_mm = contact_noise_mm_;
+  result->icp_anchors = static_cast<int>(anchors.size());
+  result->icp = AlignAt(object, setup, *pose, anchors, result);
+  // A registration that lands far off (a bad contact, a slipped finger) leaves ICP few pairs;
+  // from where the object was, it may find more.
+  const double paired = static_cast<double>(result->icp.inliers) / object.points.size();
+  if (result->pairwise.ok && (!result->icp.ok || paired < options_.icp_retry_fraction)) {
+    IcpResult retry = AlignAt(object, setup, cam_from_object_, {}, result);
+    if (retry.ok && retry.inliers > 1.2 * result->icp.inliers) {
+      result->icp = std::move(retry);
+      result->icp_from_previous = true;
+    }
+  }
+  if (result->icp.ok) {
+    *pose = result->icp.cam_from_volume;
+    return true;
+  }
+  return result->pairwise.ok;
+}
+
+bool ObjectFusion::ContactsSpread(const FusionResult& result) const {
+  return result.pairwise.contact_spread_mm >= options_.pairwise.min_contact_spread_mm;
+}
+
+std::vector<IcpAnchor> ObjectFusion::ContactAnchors(const std::vector<PointMatch>& contacts,
+                                                    const Rigid3& pose,
+                                                    const FusionResult& result) const {
+  std::vector<IcpAnchor> anchors;
+  if (!(options_.pairwise.contact_weight > 0 &&
+        static_cast<int>(contacts.size()) >= options_.pairwise.min_contacts &&
+        (!options_.icp_contacts_need_spread || (result.pairwise.ok && ContactsSpread(result))))) {
+    return anchors;
+  }
+  const Rigid3 predicted_step = pose * cam_from_object_.Inverse();
+  const double inlier_sq = options_.pairwise.inlier_mm * options_.pairwise.inlier_mm;
+  for (const PointMatch& contact : contacts) {
+    // Where feature matches fixed the motion, a contact they contradict is a mistracked
+    // fingertip (see PairwiseOptions::check_contacts): it must not steer what the surface
+    // leaves free and the features saw (a flat face's sliding). This is checked against the
+    // registered motion (features and contacts), not RegisterPair's features-only one: it
+    // also drops contacts that disagree with the other fingertips (taking RegisterPair's
+    // verdict instead raised the pin session's pairwise error from 0.55 to 0.60 mm).
+    if (options_.pairwise.check_contacts && result.pairwise.visual_inliers > 0 &&
+        (predicted_step * contact.previous - contact.current).squaredNorm() > inlier_sq) {
+      continue;
+    }
+    anchors.push_back(
+        {contact.current, predicted_step * contact.previous, options_.pairwise.contact_weight});
+  }
+  return anchors;
+}
+
+ObjectFusion::IcpSetup ObjectFusion::PrepareIcp(const ObjectPixels& object, const Rigid3& pose,
+                                                const FusionResult& result) {
+  const std::array<int, 4>& box = object.box;
+  IcpSetup setup;
+  // The model where the object's points are, grown by what ICP can still pair them over
+  // (a point moves by less than that between ICP's start and its end).
+  const int margin = static_cast<int>(std::ceil(2 * options_.icp.max_distance_mm * intrinsics_.fx /
+                                                std::max(1.0, pose.translation().z())));
+  setup.roi = {box[0] - margin, box[1] - margin, box[2] + margin, box[3] + margin};
+  // The model is needed only near the object's points: rays start a little in front of them.
+  near_depth_.assign(object.frame.depth_mm.size(), 0);
+  for (int v = std::max(0, box[1]); v < box[3]; ++v) {
+    for (int u = std::max(0, box[0]); u < box[2]; ++u) {
+      const int pixel = v * object.frame.width + u;
+      if (object.mask[pixel]) near_depth_[pixel] = object.frame.depth_mm[pixel];
+    }
+  }
+  setup.window = static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
+  setup.options = options_.icp;
+  // Contacts that fix a point but hardly a turn decide only what the surface leaves free.
+  setup.options.anchors_free_directions_only = !ContactsSpread(result);
+  if (options_.contact_noise_reference_mm > 0 && contact_noise_mm_ > 0) {
+    const double ratio = options_.contact_noise_reference_mm / contact_noise_mm_;
+    setup.options.anchor_share *= std::clamp(ratio * ratio, 0.01, 100.0);
+  }
+  return setup;
+}
+
+IcpResult ObjectFusion::AlignAt(const ObjectPixels& object, const IcpSetup& setup,
+                                const Rigid3& predicted, const std::vector<IcpAnchor>& anchors,
+                                FusionResult* result) {
+  const auto raycast_start = SteadyClock::now();
+  volume_.Raycast(intrinsics_, predicted, setup.roi, &near_depth_, setup.window, &model_image_);
+  result->raycast_ms += MillisecondsSince(raycast_start);
+  const auto icp_start = SteadyClock::now();
+  IcpResult icp =
+      AlignToModel(object.points, model_image_, intrinsics_, predicted, setup.options, anchors);
+  result->icp_ms += MillisecondsSince(icp_start);
+  return icp;
+}
+
+std::string ObjectFusion::ImplausibleJump(const Rigid3& pose, const Rigid3& step) const {
+  // A plausible step from the previous pose?
   const double moved = (pose.translation() - cam_from_object_.translation()).norm();
   const double turned = Eigen::AngleAxisd(step.rotation()).angle() * 180.0 / M_PI;
   if (moved > options_.max_jump_mm || turned > options_.max_jump_deg) {
     char reason[128];
     std::snprintf(reason, sizeof reason, "implausible jump: %.1f mm, %.1f° from the last frame",
                   moved, turned);
-    return finish(FusionStatus::kSkipped, reason);
+    return reason;
   }
+  return {};
+}
+
+void ObjectFusion::UpdateContactNoise(const std::vector<PointMatch>& contacts, const Rigid3& step,
+                                      FusionResult* result) {
   // How far the contacts land from the final motion: their noise, for the next frames' weight.
   // Only where they held ICP (a frame whose registration did without them may have lost the
   // turn they saw, and that is not their noise).
-  if (!contacts.empty() && options_.pairwise.contact_weight > 0 && result.pairwise.ok &&
-      result.icp.ok && !result.icp_from_previous) {
-    std::vector<double> residuals;
-    for (const PointMatch& contact : contacts)
-      residuals.push_back((step * contact.previous - contact.current).norm());
-    std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
-    result.contact_residual_mm = residuals[residuals.size() / 2];
-    // A running mean of the per-frame medians over about 20 frames (a frame of bad contacts
-    // moves it a little; a worse tracker moves it for good).
-    if (contact_noise_mm_ > 0) {
-      contact_noise_mm_ += 0.05 * (std::max(0.05, result.contact_residual_mm) - contact_noise_mm_);
-    }
+  if (contacts.empty() || !(options_.pairwise.contact_weight > 0) || !result->pairwise.ok ||
+      !result->icp.ok || result->icp_from_previous) {
+    return;
   }
-  cam_from_object_ = pose;
-  result.cam_from_object = pose;
-  const auto integrate_start = SteadyClock::now();
-  result.integrated_voxels = volume_.Integrate(frame, mask, intrinsics_, pose);
-  result.integrate_ms = MillisecondsSince(integrate_start);
-  free_space_.Observe(frame, box, pose, input.hand);
-  UpdateAnchors(contacts, pose);
-  return finish(FusionStatus::kFused);
+  std::vector<double> residuals;
+  for (const PointMatch& contact : contacts)
+    residuals.push_back((step * contact.previous - contact.current).norm());
+  std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
+  result->contact_residual_mm = residuals[residuals.size() / 2];
+  // A running mean of the per-frame medians over about 20 frames (a frame of bad contacts
+  // moves it a little; a worse tracker moves it for good).
+  if (contact_noise_mm_ > 0) {
+    contact_noise_mm_ += 0.05 * (std::max(0.05, result->contact_residual_mm) - contact_noise_mm_);
+  }
 }
 
 }  // namespace ihs::fusion

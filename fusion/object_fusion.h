@@ -5,6 +5,7 @@
 // One obvious entry point: Fuse(input). The volume is placed around the object in the first
 // frame; its frame is the object frame of everything that follows.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
@@ -13,6 +14,7 @@
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
 #include "core/rigid3.h"
+#include "core/stopwatch.h"
 #include "core/triangle_mesh.h"
 #include "fusion/free_space.h"
 #include "fusion/icp.h"
@@ -168,6 +170,56 @@ class ObjectFusion {
   const FusionOptions& options() const { return options_; }
 
  private:
+  // A frame's object: its pixels' points (camera frame, mm) and their bounding box in the image
+  // (u0, v0, u1, v1; end exclusive).
+  struct ObjectPixels {
+    const Frame& frame;
+    const std::vector<std::uint8_t>& mask;
+    std::vector<Eigen::Vector3f> points;
+    std::array<int, 4> box;
+  };
+  // What ICP needs for a frame: the image region the model is raycast in, how far in front of
+  // the object's points the rays start, and its options for the frame.
+  struct IcpSetup {
+    std::array<int, 4> roi;
+    float window = 0;
+    IcpOptions options;
+  };
+
+  // Completes `result` with `status` and `reason`, keeps the hand and the coverage of a
+  // registered frame, and returns it.
+  FusionResult Finish(const FusionInput& input, SteadyClock::time_point started_at,
+                      FusionStatus status, std::string reason, FusionResult* result);
+  // The object's points under `mask`.
+  ObjectPixels FindObject(const Frame& frame, const std::vector<std::uint8_t>& mask) const;
+  // The first frame: places the volume around the object and integrates it.
+  void Start(const FusionInput& input, const ObjectPixels& object, FusionResult* result);
+  // Takes `pose` as the object's, integrates the frame at it and keeps its free space.
+  void Integrate(const FusionInput& input, const ObjectPixels& object, const Rigid3& pose,
+                 FusionResult* result);
+  // The correspondences' motion applied to the previous pose (that pose where the registration
+  // fails); `contacts` gets the contact pairs used (the model's included, anchors applied).
+  Rigid3 Register(const FusionInput& input, std::vector<PointMatch>* contacts,
+                  FusionResult* result) const;
+  // ICP from the registered `pose` (and from the previous one where that pairs too few), which
+  // it replaces when ICP succeeds; false when neither the registration nor ICP found a pose.
+  bool Refine(const ObjectPixels& object, const std::vector<PointMatch>& contacts, Rigid3* pose,
+              FusionResult* result);
+  // Whether the registration's contacts spread far enough to fix a turn.
+  bool ContactsSpread(const FusionResult& result) const;
+  // The contacts that hold ICP, at where the registered `pose` moves them.
+  std::vector<IcpAnchor> ContactAnchors(const std::vector<PointMatch>& contacts, const Rigid3& pose,
+                                        const FusionResult& result) const;
+  // The raycast region, the near depth (near_depth_) and the ICP options for a frame at `pose`.
+  IcpSetup PrepareIcp(const ObjectPixels& object, const Rigid3& pose, const FusionResult& result);
+  // Raycasts the model at `predicted` and aligns the object's points to it (timed in `result`).
+  IcpResult AlignAt(const ObjectPixels& object, const IcpSetup& setup, const Rigid3& predicted,
+                    const std::vector<IcpAnchor>& anchors, FusionResult* result);
+  // Why the step from the previous pose to `pose` is implausible (empty when it is not).
+  std::string ImplausibleJump(const Rigid3& pose, const Rigid3& step) const;
+  // Updates the running estimate of the contacts' noise from how far `step` leaves them.
+  void UpdateContactNoise(const std::vector<PointMatch>& contacts, const Rigid3& step,
+                          FusionResult* result);
   // Adds the fingertip contacts found against the model that `contacts` lacks (by id); returns
   // how many pairs.
   int AddModelContacts(const FusionInput& input, std::vector<PointMatch>* contacts) const;
