@@ -83,6 +83,13 @@ std::string Cell(double value, const char* format = "%.2f") {
   return std::isfinite(value) ? Format(format, value) : "–";
 }
 
+/// The mean of `values`; NaN when there are none.
+double Mean(const std::vector<double>& values) {
+  double sum = 0;
+  for (double v : values) sum += v;
+  return values.empty() ? NAN : sum / values.size();
+}
+
 // Pooled mean and standard deviation of several (mean, std, count) groups.
 struct Pooled {
   double sum = 0, sum_squares = 0;
@@ -121,17 +128,182 @@ double AngleSinceFirst(const Rigid3& first, const Rigid3& pose) {
   return delta.angle() * 180 / M_PI;
 }
 
-}  // namespace
+/// A table header: the `lead` columns, then one per compared method (its name + `suffix`).
+std::vector<std::string> MethodHeader(std::vector<std::string> lead,
+                                      const std::vector<std::string>& compared,
+                                      const std::string& suffix = "") {
+  for (const auto& name : compared) lead.push_back(name + suffix);
+  return lead;
+}
 
-std::string WriteReport(const std::vector<CaseResult>& results, const std::vector<Method>& methods,
-                        const ReportOptions& options) {
-  const fs::path assets = options.out / "benchmarks";
+/// Appends to `row` one cell per compared method: `cell_of` its result, or `missing` where the
+/// method failed or did not run on the case.
+template <typename CellOf>
+void AppendMethodCells(std::vector<std::string>& row, const CaseResult& r,
+                       const std::vector<std::string>& compared, CellOf cell_of,
+                       const char* missing = "failed") {
+  for (const auto& name : compared) {
+    const MethodResult* m = Find(r, name);
+    row.push_back(m && m->ok ? cell_of(*m) : missing);
+  }
+}
+
+/// The method's time per frame in its object stage (SIFT + fusion), ms.
+double ObjectStageMs(const json& measures) {
+  const json& ms = measures.value("ms_per_frame", json::object());
+  return ms.value("features", 0.0) + ms.value("fusion", 0.0);
+}
+
+/// Table 2's cell: pairwise error mean ± std, and how many frames the method kept.
+std::string PairwiseCell(const MethodResult& m) {
+  const json& j = m.measures;
+  const double samples = Number(j, "pairwise_error_mm", "samples");
+  std::string cell = samples > 0 ? Cell(Number(j, "pairwise_error_mm", "mean")) + " ± " +
+                                       Cell(Number(j, "pairwise_error_mm", "std"))
+                                 : "no pairs";
+  // Frames the method could not register are not in its error: say how many it kept.
+  if (m.registered < m.frames)
+    cell += " (" + std::to_string(m.registered) + "/" + std::to_string(m.frames) + ")";
+  return cell;
+}
+
+/// A sphere's volume cell: the volume error and the share of the watertight surface Poisson
+/// made up, "–" where it was not measured.
+std::string VolumeCell(const MethodResult& m) {
+  const double v = Number(m.measures, "volume_error");
+  const double unseen = Number(m.measures, "volume_unseen_share");
+  return !std::isfinite(v) ? "–"
+         : std::isfinite(unseen)
+             ? Format("%+.1f %%", 100 * v) + Format(" (%.0f %% unseen)", 100 * unseen)
+             : Format("%+.1f %%", 100 * v);
+}
+
+/// results.csv: every case × method with every measure.
+Csv ResultsCsv(const std::vector<CaseResult>& results) {
+  Csv csv{{"case",
+           "method",
+           "ok",
+           "frames",
+           "registered",
+           "pairwise_mean_mm",
+           "pairwise_std_mm",
+           "pairwise_samples",
+           "drift_mean_mm",
+           "chamfer_mm",
+           "completeness",
+           "dimension_error_mean_mm",
+           "volume_error",
+           "volume_unseen_share",
+           "fusion_ms",
+           "export_ms",
+           "joint_error_mm",
+           "track_ms",
+           "app_fps",
+           "app_peak_mib",
+           "error"},
+          {}};
+  for (const CaseResult& r : results) {
+    for (const MethodResult& m : r.methods) {
+      const json& j = m.measures;
+      std::string why = m.error;
+      std::replace(why.begin(), why.end(), ',', ';');
+      csv.rows.push_back({r.bench_case.name,
+                          m.method,
+                          m.ok ? "1" : "0",
+                          std::to_string(m.frames),
+                          std::to_string(m.registered),
+                          Cell(Number(j, "pairwise_error_mm", "mean"), "%.3f"),
+                          Cell(Number(j, "pairwise_error_mm", "std"), "%.3f"),
+                          Cell(Number(j, "pairwise_error_mm", "samples"), "%.0f"),
+                          Cell(Number(j, "trajectory_error_mm", "mean"), "%.3f"),
+                          Cell(Number(j, "chamfer_mm"), "%.3f"),
+                          Cell(Number(j, "completeness"), "%.4f"),
+                          Cell(Number(j, "dimension_error_mm_mean"), "%.3f"),
+                          Cell(Number(j, "volume_error"), "%.4f"),
+                          Cell(Number(j, "volume_unseen_share"), "%.4f"),
+                          Format("%.2f", ObjectStageMs(j)),
+                          Cell(Number(j, "export_ms"), "%.0f"),
+                          Format("%.2f", r.joint_error_mm),
+                          Format("%.2f", r.track_ms + r.mask_ms),
+                          Format("%.1f", r.app_fps),
+                          Format("%.0f", r.app_peak_mib),
+                          why});
+    }
+  }
+  return csv;
+}
+
+/// The truth's rotation since its first pose, over time since then.
+Series TruthRotation(const std::vector<StampedPose>& truth) {
+  Series series{"truth", {}, {}, {0, 0, 0}, false, true};
+  for (const StampedPose& p : truth) {
+    series.x.push_back(p.time_s - truth.front().time_s);
+    series.y.push_back(AngleSinceFirst(truth.front().transform, p.transform));
+  }
+  return series;
+}
+
+/// Adds to `rotation` and `drift` the method's rotation since the truth's first pose and its
+/// drift over time (the caller checked that both trajectories have poses).
+void AddMethodTrajectory(const CaseResult& r, const MethodResult& m, Series& rotation,
+                         Series& drift) {
+  // The method's first pose stands for the truth's at that time.
+  const StampedPose* first_truth = eval::FindPose(r.truth, m.trajectory.front().time_s);
+  const Rigid3 offset =
+      first_truth ? m.trajectory.front().transform.Inverse() * first_truth->transform : Rigid3();
+  for (const StampedPose& p : m.trajectory) {
+    rotation.x.push_back(p.time_s - r.truth.front().time_s);
+    rotation.y.push_back(AngleSinceFirst(r.truth.front().transform, p.transform * offset));
+  }
+  const eval::TrajectoryError e = eval::CompareTrajectory(r.gt_dir, m.trajectory);
+  for (size_t i = 0; i < e.times_s.size(); ++i) {
+    drift.x.push_back(e.times_s[i] - r.truth.front().time_s);
+    drift.y.push_back(std::max(e.errors_mm[i], 0.01));
+  }
+}
+
+// The state of one WriteReport call: its inputs, the Markdown so far, and what later sections
+// take from earlier ones (Table 1's errors and CSV, Table 2's pooled errors, the sweep's CSV).
+struct ReportWriter {
+  const std::vector<CaseResult>& results;
+  const std::vector<Method>& methods;
+  const ReportOptions& options;
+  fs::path assets;
+  /// Methods compared in the tables.
+  std::vector<std::string> compared;
+  std::ostringstream md;
+  Csv table1_csv{{"case", "measure", "truth_mm", "method", "scan_mm", "error_mm"}, {}};
+  Csv sweep_csv{{"case", "gamma_t", "pairwise_mean_mm", "pairwise_std_mm", "drift_mean_mm"}, {}};
+  /// Table 1's absolute dimension errors over the paper sessions, per method.
+  std::map<std::string, std::vector<double>> abs_errors;
+  /// Table 2's pairwise errors pooled over the paper sessions, per method.
+  std::map<std::string, Pooled> pooled;
+
+  ReportWriter(const std::vector<CaseResult>& results, const std::vector<Method>& methods,
+               const ReportOptions& options);
+  void Introduction();
+  void Table1();
+  void DimensionRows(const CaseResult& r, Table& table);
+  void Table2();
+  void Ratios();
+  void SurfaceDriftSpeed();
+  void Stages();
+  void Sweep();
+  void TrajectoriesAndMeshes();
+  void CaseCharts(const CaseResult& r);
+  void CaseMeshes(const CaseResult& r, MeshView& view);
+  std::string Files();
+};
+
+/// Creates the assets folder and picks the compared methods.
+ReportWriter::ReportWriter(const std::vector<CaseResult>& results,
+                           const std::vector<Method>& methods, const ReportOptions& options)
+    : results(results), methods(methods), options(options), assets(options.out / "benchmarks") {
   std::error_code error;
   fs::create_directories(assets, error);
   if (error) throw OutputError(assets.string() + ": cannot create (" + error.message() + ")");
 
   // Methods compared in the tables: all but the sweep's extra γt values, Open3D last if run.
-  std::vector<std::string> compared;
   for (const Method& m : methods)
     if (!m.sweep_only) compared.push_back(m.name);
   for (const CaseResult& r : results) {
@@ -140,8 +312,10 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
       break;
     }
   }
+}
 
-  std::ostringstream md;
+/// The title, how the report was made, what the methods are, and the table of cases.
+void ReportWriter::Introduction() {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
@@ -166,60 +340,48 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
        << motion << " | " << (r.methods.empty() ? 0 : r.methods.front().frames) << " |\n";
   }
   md << "\n";
+}
 
-  // Table 1.
-  Table table1;
-  table1.header = {"case", "measure", "truth"};
-  for (const auto& m : compared) table1.header.push_back(m);
-  Csv table1_csv{{"case", "measure", "truth_mm", "method", "scan_mm", "error_mm"}, {}};
-  std::map<std::string, std::vector<double>> abs_errors;
-  std::map<std::string, std::string> volume_cells;
-  bool sphere_volume = false;
-  for (const CaseResult& r : results) {
-    const MethodResult* reference = Find(r, "ours");
-    if (!reference || !reference->measures.contains("dimensions")) continue;
-    for (size_t d = 0; d < reference->measures["dimensions"].size(); ++d) {
-      const json& row = reference->measures["dimensions"][d];
-      const double truth = row["truth_mm"].get<double>();
-      std::vector<std::string> cells = {r.bench_case.name, row["measure"].get<std::string>(),
-                                        Format("%.1f", truth)};
-      for (const auto& name : compared) {
-        const MethodResult* m = Find(r, name);
-        if (!m || !m->ok || !m->measures.contains("dimensions") ||
-            m->measures["dimensions"].size() <= d) {
-          cells.push_back("failed");
-          continue;
-        }
-        const double scan = m->measures["dimensions"][d]["scan_mm"].get<double>();
-        cells.push_back(Format("%.1f", scan) + " (" + Format("%+.1f", scan - truth) + ")");
-        if (r.bench_case.paper) abs_errors[name].push_back(std::abs(scan - truth));
-        table1_csv.rows.push_back({r.bench_case.name, row["measure"].get<std::string>(),
-                                   Format("%.2f", truth), name, Format("%.2f", scan),
-                                   Format("%.2f", scan - truth)});
-      }
-      table1.rows.push_back(cells);
-    }
+/// Table 1's rows of one case: each dimension ours measured, every method's scan and error;
+/// collects the CSV rows and the paper sessions' absolute errors.
+void ReportWriter::DimensionRows(const CaseResult& r, Table& table) {
+  const MethodResult* reference = Find(r, "ours");
+  if (!reference || !reference->measures.contains("dimensions")) return;
+  for (size_t d = 0; d < reference->measures["dimensions"].size(); ++d) {
+    const json& row = reference->measures["dimensions"][d];
+    const double truth = row["truth_mm"].get<double>();
+    std::vector<std::string> cells = {r.bench_case.name, row["measure"].get<std::string>(),
+                                      Format("%.1f", truth)};
+    AppendMethodCells(cells, r, compared, [&](const MethodResult& m) -> std::string {
+      if (!m.measures.contains("dimensions") || m.measures["dimensions"].size() <= d)
+        return "failed";
+      const double scan = m.measures["dimensions"][d]["scan_mm"].get<double>();
+      if (r.bench_case.paper) abs_errors[m.method].push_back(std::abs(scan - truth));
+      table1_csv.rows.push_back({r.bench_case.name, row["measure"].get<std::string>(),
+                                 Format("%.2f", truth), m.method, Format("%.2f", scan),
+                                 Format("%.2f", scan - truth)});
+      return Format("%.1f", scan) + " (" + Format("%+.1f", scan - truth) + ")";
+    });
+    table.rows.push_back(cells);
   }
+}
+
+/// Table 1: dimensions per case, the paper sessions' mean absolute error, sphere volumes.
+void ReportWriter::Table1() {
+  Table table1;
+  table1.header = MethodHeader({"case", "measure", "truth"}, compared);
+  for (const CaseResult& r : results) DimensionRows(r, table1);
   std::vector<std::string> mean_row = {"**paper sessions**", "**mean abs. error**", ""};
   for (const auto& name : compared) {
     const auto& e = abs_errors[name];
-    double sum = 0;
-    for (double v : e) sum += v;
-    mean_row.push_back(e.empty() ? "–" : "**" + Format("%.2f", sum / e.size()) + "**");
+    mean_row.push_back(e.empty() ? "–" : "**" + Format("%.2f", Mean(e)) + "**");
   }
   if (!abs_errors.empty()) table1.rows.push_back(mean_row);
+  bool sphere_volume = false;
   for (const CaseResult& r : results) {
     if (r.bench_case.object != "sphere") continue;
     std::vector<std::string> cells = {r.bench_case.name, "volume error", ""};
-    for (const auto& name : compared) {
-      const MethodResult* m = Find(r, name);
-      const double v = m && m->ok ? Number(m->measures, "volume_error") : NAN;
-      const double unseen = m && m->ok ? Number(m->measures, "volume_unseen_share") : NAN;
-      cells.push_back(!std::isfinite(v) ? "–"
-                      : std::isfinite(unseen)
-                          ? Format("%+.1f %%", 100 * v) + Format(" (%.0f %% unseen)", 100 * unseen)
-                          : Format("%+.1f %%", 100 * v));
-    }
+    AppendMethodCells(cells, r, compared, VolumeCell, "–");
     table1.rows.push_back(cells);
     sphere_volume = true;
   }
@@ -232,108 +394,23 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
           "the whole sphere (004-sphere-whole, when it is run) is where the volume is "
           "measured.\n\n";
   }
+}
 
-  // Table 2 and the other per-case measures.
-  Table table2, surface, drift, speed;
-  table2.header = surface.header = drift.header = {"case", "joint err."};
-  speed.header = {"case", "track+mask ms"};
-  for (const auto& name : compared) {
-    table2.header.push_back(name);
-    surface.header.push_back(name);
-    drift.header.push_back(name);
-    speed.header.push_back(name + " ms");
-  }
-  speed.header.push_back("export s (ours)");
-  speed.header.push_back("app fps");
-  speed.header.push_back("app peak MiB");
-  Csv results_csv{{"case",
-                   "method",
-                   "ok",
-                   "frames",
-                   "registered",
-                   "pairwise_mean_mm",
-                   "pairwise_std_mm",
-                   "pairwise_samples",
-                   "drift_mean_mm",
-                   "chamfer_mm",
-                   "completeness",
-                   "dimension_error_mean_mm",
-                   "volume_error",
-                   "volume_unseen_share",
-                   "fusion_ms",
-                   "export_ms",
-                   "joint_error_mm",
-                   "track_ms",
-                   "app_fps",
-                   "app_peak_mib",
-                   "error"},
-                  {}};
-  std::map<std::string, Pooled> pooled;
+/// Table 2: pairwise registration error per case and method, pooled over the paper sessions.
+void ReportWriter::Table2() {
+  Table table2;
+  table2.header = MethodHeader({"case", "joint err."}, compared);
   for (const CaseResult& r : results) {
-    const std::string joint = Cell(r.joint_error_mm, "%.1f mm");
-    std::vector<std::string> t2 = {r.bench_case.name, joint}, su = t2, dr = t2;
-    std::vector<std::string> sp = {r.bench_case.name, Format("%.1f", r.track_ms + r.mask_ms)};
-    for (const auto& name : compared) {
-      const MethodResult* m = Find(r, name);
-      if (!m || !m->ok) {
-        for (auto* row : {&t2, &su, &dr, &sp}) row->push_back("failed");
-        continue;
-      }
-      const json& j = m->measures;
-      const double mean = Number(j, "pairwise_error_mm", "mean");
-      const double std = Number(j, "pairwise_error_mm", "std");
-      const double samples = Number(j, "pairwise_error_mm", "samples");
-      std::string cell = samples > 0 ? Cell(mean) + " ± " + Cell(std) : "no pairs";
-      // Frames the method could not register are not in its error: say how many it kept.
-      if (m->registered < m->frames)
-        cell += " (" + std::to_string(m->registered) + "/" + std::to_string(m->frames) + ")";
-      t2.push_back(cell);
-      if (r.bench_case.paper)
-        pooled[name].Add(mean, std, Number(j, "pairwise_error_mm", "samples"));
-      su.push_back(Cell(Number(j, "chamfer_mm")) + " / " +
-                   Cell(100 * Number(j, "completeness"), "%.0f %%"));
-      dr.push_back(Cell(Number(j, "trajectory_error_mm", "mean"), "%.1f"));
-      const json& ms = j.value("ms_per_frame", json::object());
-      const double fusion_ms = ms.value("features", 0.0) + ms.value("fusion", 0.0);
-      sp.push_back(Format("%.1f", fusion_ms));
-    }
-    const MethodResult* ours = Find(r, "ours");
-    sp.push_back(ours && ours->ok ? Format("%.1f", Number(ours->measures, "export_ms") / 1000)
-                                  : "–");
-    sp.push_back(r.app_fps > 0 ? Format("%.1f", r.app_fps) : "–");
-    sp.push_back(r.app_peak_mib > 0 ? Format("%.0f", r.app_peak_mib) : "–");
-    table2.rows.push_back(t2);
-    surface.rows.push_back(su);
-    drift.rows.push_back(dr);
-    speed.rows.push_back(sp);
-    for (const MethodResult& m : r.methods) {
+    std::vector<std::string> row = {r.bench_case.name, Cell(r.joint_error_mm, "%.1f mm")};
+    AppendMethodCells(row, r, compared, [&](const MethodResult& m) {
       const json& j = m.measures;
-      const json& ms = j.value("ms_per_frame", json::object());
-      std::string why = m.error;
-      std::replace(why.begin(), why.end(), ',', ';');
-      results_csv.rows.push_back(
-          {r.bench_case.name,
-           m.method,
-           m.ok ? "1" : "0",
-           std::to_string(m.frames),
-           std::to_string(m.registered),
-           Cell(Number(j, "pairwise_error_mm", "mean"), "%.3f"),
-           Cell(Number(j, "pairwise_error_mm", "std"), "%.3f"),
-           Cell(Number(j, "pairwise_error_mm", "samples"), "%.0f"),
-           Cell(Number(j, "trajectory_error_mm", "mean"), "%.3f"),
-           Cell(Number(j, "chamfer_mm"), "%.3f"),
-           Cell(Number(j, "completeness"), "%.4f"),
-           Cell(Number(j, "dimension_error_mm_mean"), "%.3f"),
-           Cell(Number(j, "volume_error"), "%.4f"),
-           Cell(Number(j, "volume_unseen_share"), "%.4f"),
-           Format("%.2f", ms.value("features", 0.0) + ms.value("fusion", 0.0)),
-           Cell(Number(j, "export_ms"), "%.0f"),
-           Format("%.2f", r.joint_error_mm),
-           Format("%.2f", r.track_ms + r.mask_ms),
-           Format("%.1f", r.app_fps),
-           Format("%.0f", r.app_peak_mib),
-           why});
-    }
+      if (r.bench_case.paper)
+        pooled[m.method].Add(Number(j, "pairwise_error_mm", "mean"),
+                             Number(j, "pairwise_error_mm", "std"),
+                             Number(j, "pairwise_error_mm", "samples"));
+      return PairwiseCell(m);
+    });
+    table2.rows.push_back(row);
   }
   if (!pooled.empty()) {
     std::vector<std::string> row = {"**paper sessions**", ""};
@@ -350,23 +427,52 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
         "error (the same for every method). An error larger than the object means the method "
         "lost it.\n\n"
      << table2.Markdown() << "\n";
+}
 
-  // Ratios to the baselines.
-  if (!pooled.empty() && pooled["ours"].n > 0) {
-    md << "Ratios over the paper sessions (baseline ÷ ours):\n\n| baseline | Table 1 mean abs. "
-          "error | Table 2 pairwise error |\n|---|---:|---:|\n";
-    auto mean_of = [](const std::vector<double>& v) {
-      double s = 0;
-      for (double x : v) s += x;
-      return v.empty() ? NAN : s / v.size();
-    };
-    const double ours_dim = mean_of(abs_errors["ours"]), ours_pair = pooled["ours"].Mean();
-    for (const auto& name : compared) {
-      if (name == "ours") continue;
-      md << "| " << name << " | " << Cell(mean_of(abs_errors[name]) / ours_dim, "%.1f×") << " | "
-         << Cell(pooled[name].Mean() / ours_pair, "%.1f×") << " |\n";
-    }
-    md << "\n";
+/// Ratios to the baselines over the paper sessions (when ours has pooled pairwise errors).
+void ReportWriter::Ratios() {
+  if (pooled.empty() || !(pooled["ours"].n > 0)) return;
+  md << "Ratios over the paper sessions (baseline ÷ ours):\n\n| baseline | Table 1 mean abs. "
+        "error | Table 2 pairwise error |\n|---|---:|---:|\n";
+  const double ours_dim = Mean(abs_errors["ours"]), ours_pair = pooled["ours"].Mean();
+  for (const auto& name : compared) {
+    if (name == "ours") continue;
+    md << "| " << name << " | " << Cell(Mean(abs_errors[name]) / ours_dim, "%.1f×") << " | "
+       << Cell(pooled[name].Mean() / ours_pair, "%.1f×") << " |\n";
+  }
+  md << "\n";
+}
+
+/// The surface (Chamfer, completeness), trajectory drift, and speed and memory tables.
+void ReportWriter::SurfaceDriftSpeed() {
+  Table surface, drift, speed;
+  surface.header = drift.header = MethodHeader({"case", "joint err."}, compared);
+  speed.header = MethodHeader({"case", "track+mask ms"}, compared, " ms");
+  speed.header.push_back("export s (ours)");
+  speed.header.push_back("app fps");
+  speed.header.push_back("app peak MiB");
+  for (const CaseResult& r : results) {
+    const std::string joint = Cell(r.joint_error_mm, "%.1f mm");
+    std::vector<std::string> su = {r.bench_case.name, joint}, dr = su;
+    std::vector<std::string> sp = {r.bench_case.name, Format("%.1f", r.track_ms + r.mask_ms)};
+    AppendMethodCells(su, r, compared, [](const MethodResult& m) {
+      return Cell(Number(m.measures, "chamfer_mm")) + " / " +
+             Cell(100 * Number(m.measures, "completeness"), "%.0f %%");
+    });
+    AppendMethodCells(dr, r, compared, [](const MethodResult& m) {
+      return Cell(Number(m.measures, "trajectory_error_mm", "mean"), "%.1f");
+    });
+    AppendMethodCells(sp, r, compared, [](const MethodResult& m) {
+      return Format("%.1f", ObjectStageMs(m.measures));
+    });
+    const MethodResult* ours = Find(r, "ours");
+    sp.push_back(ours && ours->ok ? Format("%.1f", Number(ours->measures, "export_ms") / 1000)
+                                  : "–");
+    sp.push_back(r.app_fps > 0 ? Format("%.1f", r.app_fps) : "–");
+    sp.push_back(r.app_peak_mib > 0 ? Format("%.0f", r.app_peak_mib) : "–");
+    surface.rows.push_back(su);
+    drift.rows.push_back(dr);
+    speed.rows.push_back(sp);
   }
   md << "## Surface: Chamfer distance (mm) / completeness (true surface within 2 mm)\n\n"
      << surface.Markdown() << "\n"
@@ -380,8 +486,10 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
         "Poisson. App: `inhandscan replay` on the same recording, threaded, as fast as it goes, "
         "with its peak resident memory.\n\n"
      << speed.Markdown() << "\n";
+}
 
-  // Where ours spends its time, stage by stage.
+/// Where ours spends its time, stage by stage.
+void ReportWriter::Stages() {
   Table stages;
   stages.header = {"case",     "segmentation", "hand fit", "contacts",  "hand mask", "SIFT",
                    "pairwise", "raycast",      "ICP",      "integrate", "total"};
@@ -400,9 +508,10 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
   md << "Ours, ms per frame by stage (tracker: segmentation, hand fit, contacts, hand mask; "
         "object: SIFT, pairwise solve, raycast of the model, ICP, TSDF integration):\n\n"
      << stages.Markdown() << "\n";
+}
 
-  // γt sweep.
-  Csv sweep_csv{{"case", "gamma_t", "pairwise_mean_mm", "pairwise_std_mm", "drift_mean_mm"}, {}};
+/// The γt sweep: pairwise error per case and γt, as a table, a chart and a CSV.
+void ReportWriter::Sweep() {
   Chart sweep_chart;
   sweep_chart.title = "Pairwise registration error vs gamma_t (contact weight)";
   sweep_chart.x_label = "gamma_t";
@@ -438,8 +547,10 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
   WriteChartPng(sweep_chart, assets / "gamma_sweep.png");
   md << "## Contact weight γt (the paper's Figure: error vs γt)\n\n"
      << sweep_table.Markdown() << "\n![error vs γt](benchmarks/gamma_sweep.png)\n\n";
+}
 
-  // Trajectories and meshes per case.
+/// Trajectories and meshes per case.
+void ReportWriter::TrajectoriesAndMeshes() {
   md << "## Trajectories and meshes\n\n"
      << "Left: the object's rotation since the first frame, truth (dashed) and each method. "
         "Right: each method's drift over time. Below: every method's watertight mesh beside the "
@@ -447,92 +558,96 @@ std::string WriteReport(const std::vector<CaseResult>& results, const std::vecto
   std::unique_ptr<MeshView> view;
   if (options.mesh_pictures) view = std::make_unique<MeshView>(280);
   for (const CaseResult& r : results) {
-    Chart angle, error_chart;
-    angle.title = r.bench_case.name + ": rotation since the first frame";
-    angle.x_label = "time (s)";
-    angle.y_label = "degrees";
-    error_chart.title = r.bench_case.name + ": drift of the object's trajectory";
-    error_chart.x_label = "time (s)";
-    error_chart.y_label = "mm";
-    error_chart.log_y = true;
-    if (!r.truth.empty()) {
-      Series truth{"truth", {}, {}, {0, 0, 0}, false, true};
-      for (const StampedPose& p : r.truth) {
-        truth.x.push_back(p.time_s - r.truth.front().time_s);
-        truth.y.push_back(AngleSinceFirst(r.truth.front().transform, p.transform));
-      }
-      angle.series.push_back(truth);
-    }
-    int k = 0;
-    for (const auto& name : compared) {
-      const MethodResult* m = Find(r, name);
-      Series a{name, {}, {}, PaletteColor(k), false, false}, d = a;
-      ++k;
-      if (m && m->ok && !m->trajectory.empty() && !r.truth.empty()) {
-        // The method's first pose stands for the truth's at that time.
-        const StampedPose* first_truth = eval::FindPose(r.truth, m->trajectory.front().time_s);
-        const Rigid3 offset =
-            first_truth ? m->trajectory.front().transform.Inverse() * first_truth->transform
-                        : Rigid3();
-        for (const StampedPose& p : m->trajectory) {
-          a.x.push_back(p.time_s - r.truth.front().time_s);
-          a.y.push_back(AngleSinceFirst(r.truth.front().transform, p.transform * offset));
-        }
-        const eval::TrajectoryError e = eval::CompareTrajectory(r.gt_dir, m->trajectory);
-        for (size_t i = 0; i < e.times_s.size(); ++i) {
-          d.x.push_back(e.times_s[i] - r.truth.front().time_s);
-          d.y.push_back(std::max(e.errors_mm[i], 0.01));
-        }
-      }
-      angle.series.push_back(a);
-      error_chart.series.push_back(d);
-    }
-    const std::string stem = r.bench_case.name;
-    WriteChartPng(angle, assets / ("rotation-" + stem + ".png"));
-    WriteChartPng(error_chart, assets / ("drift-" + stem + ".png"));
-    md << "### " << stem << "\n\n![rotation](benchmarks/rotation-" << stem
-       << ".png) ![drift](benchmarks/drift-" << stem << ".png)\n\n";
-
-    if (view) {
-      const TriangleMesh truth_mesh = ReadMesh(r.gt_dir / "object.ply");
-      Eigen::Vector3d low = Eigen::Vector3d::Constant(1e9), high = -low;
-      for (const auto& v : truth_mesh.vertices) {
-        low = low.cwiseMin(v.cast<double>());
-        high = high.cwiseMax(v.cast<double>());
-      }
-      const Eigen::Vector3d center = 0.5 * (low + high);
-      const double radius = 0.5 * (high - low).norm();
-      std::vector<Tile> tiles;
-      tiles.push_back({"truth", view->Draw(truth_mesh, Rigid3(), center, radius)});
-      for (const auto& name : compared) {
-        const MethodResult* m = Find(r, name);
-        if (!m || !m->ok || m->trajectory.empty()) {
-          tiles.push_back({name + ": failed", {}});
-          continue;
-        }
-        const StampedPose* first_truth = eval::FindPose(r.truth, m->trajectory.front().time_s);
-        const Rigid3 truth_from_scan =
-            first_truth ? first_truth->transform.Inverse() * m->trajectory.front().transform
-                        : Rigid3();
-        const TriangleMesh& mesh = m->watertight.Empty() ? m->seen : m->watertight;
-        tiles.push_back({name, view->Draw(mesh, truth_from_scan, center, radius)});
-      }
-      WriteTileGridPng(tiles, view->size(), view->size(), static_cast<int>(tiles.size()),
-                       assets / ("meshes-" + stem + ".png"));
-      md << "![meshes](benchmarks/meshes-" << stem << ".png)\n\n";
-    }
+    CaseCharts(r);
+    if (view) CaseMeshes(r, *view);
   }
+}
 
+/// The case's rotation and drift charts, side by side.
+void ReportWriter::CaseCharts(const CaseResult& r) {
+  Chart angle, error_chart;
+  angle.title = r.bench_case.name + ": rotation since the first frame";
+  angle.x_label = "time (s)";
+  angle.y_label = "degrees";
+  error_chart.title = r.bench_case.name + ": drift of the object's trajectory";
+  error_chart.x_label = "time (s)";
+  error_chart.y_label = "mm";
+  error_chart.log_y = true;
+  if (!r.truth.empty()) angle.series.push_back(TruthRotation(r.truth));
+  int k = 0;
+  for (const auto& name : compared) {
+    const MethodResult* m = Find(r, name);
+    Series a{name, {}, {}, PaletteColor(k), false, false}, d = a;
+    ++k;
+    if (m && m->ok && !m->trajectory.empty() && !r.truth.empty()) AddMethodTrajectory(r, *m, a, d);
+    angle.series.push_back(a);
+    error_chart.series.push_back(d);
+  }
+  const std::string stem = r.bench_case.name;
+  WriteChartPng(angle, assets / ("rotation-" + stem + ".png"));
+  WriteChartPng(error_chart, assets / ("drift-" + stem + ".png"));
+  md << "### " << stem << "\n\n![rotation](benchmarks/rotation-" << stem
+     << ".png) ![drift](benchmarks/drift-" << stem << ".png)\n\n";
+}
+
+/// Every method's mesh beside the true object, in the true object's frame.
+void ReportWriter::CaseMeshes(const CaseResult& r, MeshView& view) {
+  const TriangleMesh truth_mesh = ReadMesh(r.gt_dir / "object.ply");
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(1e9), high = -low;
+  for (const auto& v : truth_mesh.vertices) {
+    low = low.cwiseMin(v.cast<double>());
+    high = high.cwiseMax(v.cast<double>());
+  }
+  const Eigen::Vector3d center = 0.5 * (low + high);
+  const double radius = 0.5 * (high - low).norm();
+  std::vector<Tile> tiles;
+  tiles.push_back({"truth", view.Draw(truth_mesh, Rigid3(), center, radius)});
+  for (const auto& name : compared) {
+    const MethodResult* m = Find(r, name);
+    if (!m || !m->ok || m->trajectory.empty()) {
+      tiles.push_back({name + ": failed", {}});
+      continue;
+    }
+    const StampedPose* first_truth = eval::FindPose(r.truth, m->trajectory.front().time_s);
+    const Rigid3 truth_from_scan =
+        first_truth ? first_truth->transform.Inverse() * m->trajectory.front().transform : Rigid3();
+    const TriangleMesh& mesh = m->watertight.Empty() ? m->seen : m->watertight;
+    tiles.push_back({name, view.Draw(mesh, truth_from_scan, center, radius)});
+  }
+  const std::string stem = r.bench_case.name;
+  WriteTileGridPng(tiles, view.size(), view.size(), static_cast<int>(tiles.size()),
+                   assets / ("meshes-" + stem + ".png"));
+  md << "![meshes](benchmarks/meshes-" << stem << ".png)\n\n";
+}
+
+/// The list of files; writes the CSV files and the Markdown, and returns the Markdown.
+std::string ReportWriter::Files() {
   md << "## Files\n\n`benchmarks/results.csv` (every case × method), `benchmarks/table1.csv`, "
         "`benchmarks/gamma_sweep.csv`.\n";
   table1_csv.Write(assets / "table1.csv");
-  results_csv.Write(assets / "results.csv");
+  ResultsCsv(results).Write(assets / "results.csv");
   sweep_csv.Write(assets / "gamma_sweep.csv");
   const std::string text = md.str();
   std::ofstream file(options.out / "benchmarks.md");
   file << text;
   if (!file) throw OutputError((options.out / "benchmarks.md").string() + ": cannot write");
   return text;
+}
+
+}  // namespace
+
+std::string WriteReport(const std::vector<CaseResult>& results, const std::vector<Method>& methods,
+                        const ReportOptions& options) {
+  ReportWriter report(results, methods, options);
+  report.Introduction();
+  report.Table1();
+  report.Table2();
+  report.Ratios();
+  report.SurfaceDriftSpeed();
+  report.Stages();
+  report.Sweep();
+  report.TrajectoriesAndMeshes();
+  return report.Files();
 }
 
 }  // namespace ihs::bench
