@@ -108,7 +108,7 @@ struct Pipeline::Shared {
   SpscQueue<JobPtr> jobs;        // fusion → export
   CameraIntrinsics intrinsics;
   std::unique_ptr<HandStage> hand;
-  std::vector<std::string> bone_names;
+  std::vector<std::string> bone_names, angle_names;  // The hand stage's, for ScanRecord.
   std::vector<int> joint_parents;  // Joint j+1 ends bone j, which starts where its parent ends.
   std::chrono::steady_clock::time_point start;
   const bool live;
@@ -164,6 +164,7 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
   shared_->intrinsics = source_->Intrinsics();
   shared_->hand = std::make_unique<HandStage>(options_, shared_->intrinsics);
   shared_->bone_names = shared_->hand->BoneNames();
+  shared_->angle_names = shared_->hand->AngleNames();
   shared_->joint_parents = {-1};
   for (const auto& bone : shared_->hand->model().bones) {
     shared_->joint_parents.push_back(bone.parent < 0 ? 0 : bone.parent + 1);
@@ -174,6 +175,8 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
   if (const int removed = RemovePreviousScan(output_.folder)) {
     spdlog::info("{}: removed {} files of an earlier scan", output_.folder.string(), removed);
   }
+  run_record_ = RunRecord::Of(source_->Description(), options_);
+  run_record_.WriteOptions(output_.folder);
   shared_->start = SteadyClock::now();
   started_ = true;
   shared_->running = 4;
@@ -279,7 +282,7 @@ void Pipeline::TrackerLoop() {
 void Pipeline::FusionLoop() {
   Shared& s = *shared_;
   std::unique_ptr<ObjectStage> object;
-  auto record = std::make_shared<ScanRecord>(s.bone_names);
+  auto record = std::make_shared<ScanRecord>(s.bone_names, s.angle_names);
   std::int64_t previewed_at = 0;
   std::int64_t live_view_frame = -1000;
   // Hands a snapshot to the export thread; false when it is busy (try again later). Only this
@@ -308,7 +311,7 @@ void Pipeline::FusionLoop() {
       if (reset_requested_.exchange(false)) {
         spdlog::info("reset: the model starts anew");
         object = std::make_unique<ObjectStage>(options_, s.intrinsics);
-        record = std::make_shared<ScanRecord>(s.bone_names);
+        record = std::make_shared<ScanRecord>(s.bone_names, s.angle_names);
         s.registered = 0;
         s.coverage = 0;
         previewed_at = 0;
@@ -402,6 +405,7 @@ void Pipeline::ExportLoop() {
       job->record->WriteTables(output_.folder);
       const PipelineProgress progress = Progress();
       nlohmann::json extra = {{"source", source_->Description()},
+                              {"run", run_record_.Json(s.intrinsics)},
                               {"live", s.live},
                               {"final", final},
                               {"captured_frames", progress.captured},

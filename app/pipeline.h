@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "app/preview.h"
+#include "app/run_record.h"
 #include "app/scanner_options.h"
 #include "core/latest_value.h"
 #include "sensor/frame_source.h"
@@ -147,6 +148,7 @@ class Pipeline {
   std::unique_ptr<sensor::FrameSource> source_;
   const ScannerOptions options_;
   const PipelineOutput output_;
+  RunRecord run_record_;  // Set in Start(), before any thread; options.conf and stats.json's "run".
   std::unique_ptr<Shared> shared_;
   std::atomic<bool> export_requested_{false};
   std::atomic<bool> stop_requested_{false};

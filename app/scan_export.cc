@@ -35,7 +35,7 @@ namespace {
 
 constexpr const char* kScanFiles[] = {"mesh.ply",       "mesh_tsdf.ply",  "mesh.obj",
                                       "mesh.stl",       "trajectory.txt", "hand_joints.csv",
-                                      "hand_poses.csv", "stats.json"};
+                                      "hand_poses.csv", "stats.json",     "options.conf"};
 
 }  // namespace
 

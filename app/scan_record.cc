@@ -20,7 +20,8 @@ double Percentile(std::vector<double> values, double fraction) {
 
 }  // namespace
 
-ScanRecord::ScanRecord(std::vector<std::string> bone_names) : bone_names_(std::move(bone_names)) {}
+ScanRecord::ScanRecord(std::vector<std::string> bone_names, std::vector<std::string> angle_names)
+    : bone_names_(std::move(bone_names)), angle_names_(std::move(angle_names)) {}
 
 void ScanRecord::Add(const FramePacket& packet) {
   const Frame& frame = *packet.frame;
@@ -150,8 +151,11 @@ void ScanRecord::WriteTables(const std::filesystem::path& folder) const {
   tracker::WriteHandJointsCsv(folder / "hand_joints.csv", bone_names_, joints_);
   std::string poses =
       "# hand pose per tracked frame: cam_from_root (mm; quaternion x y z w), then the joint "
-      "angles (rad) in the template's degree-of-freedom "
-      "order\nframe,tx,ty,tz,qx,qy,qz,qw,angles...\n";
+      "angles (rad) in the template's degree-of-freedom order, BONE.x/.y/.z the rotation about "
+      "the bone's x (about twist), y (flexion) or z (spread) axis\nframe,tx,ty,tz,qx,qy,qz,qw";
+  if (angle_names_.empty()) poses += ",angles...";
+  for (const std::string& name : angle_names_) poses += "," + name;
+  poses += "\n";
   for (const std::string& row : pose_rows_) poses += row + "\n";
   WriteFileAtomically(folder / "hand_poses.csv", poses);
 }

@@ -19,8 +19,10 @@ namespace ihs::app {
 /// Per-frame log of a scan.
 class ScanRecord {
  public:
-  /// `bone_names` name the joints' columns in hand_joints.csv.
-  explicit ScanRecord(std::vector<std::string> bone_names = {});
+  /// `bone_names` name the joints' columns in hand_joints.csv, `angle_names` the joint angles'
+  /// columns in hand_poses.csv (HandStage::AngleNames; without them the header says "angles...").
+  explicit ScanRecord(std::vector<std::string> bone_names = {},
+                      std::vector<std::string> angle_names = {});
 
   /// Records a frame both stages have processed.
   void Add(const FramePacket& packet);
@@ -48,6 +50,7 @@ class ScanRecord {
 
  private:
   std::vector<std::string> bone_names_;
+  std::vector<std::string> angle_names_;
   std::int64_t frames_ = 0;
   std::int64_t doubtful_frames_ = 0;  // Frames whose hand pose was doubtful.
   std::vector<std::string> frame_json_;  // One serialised object per recorded frame.

@@ -9,6 +9,7 @@
 #include "tracker/contacts.h"
 #include "tracker/hand_data.h"
 #include "tracker/hand_kinematics.h"
+#include "tracker/hand_pose.h"
 
 namespace ihs::app {
 namespace {
@@ -53,6 +54,15 @@ double HandStage::scale() const {
 std::vector<std::string> HandStage::BoneNames() const {
   std::vector<std::string> names;
   for (const auto& bone : tracker_.model().bones) names.push_back(bone.name);
+  return names;
+}
+
+std::vector<std::string> HandStage::AngleNames() const {
+  std::vector<std::string> names;
+  const tracker::HandModel& model = tracker_.model();
+  for (const tracker::DegreeOfFreedom& dof : tracker::JointDegreesOfFreedom(model)) {
+    names.push_back(model.bones[dof.bone].name + "." + std::string(1, "xyz"[dof.axis]));
+  }
   return names;
 }
 

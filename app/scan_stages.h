@@ -88,6 +88,9 @@ class HandStage {
   bool scale_at_bound() const { return tracker_.scale_at_bound(); }
   /// Names of the template's bones (the joints' columns).
   std::vector<std::string> BoneNames() const;
+  /// The joint angles' names in HandPose::angles_rad order: "BONE.x", "BONE.y" or "BONE.z", the
+  /// rotation about that axis of the bone (tracker::JointDegreesOfFreedom).
+  std::vector<std::string> AngleNames() const;
 
  private:
   const ScanOptions options_;

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "app/run_record.h"
 #include "app/scan_export.h"
 #include "app/scan_record.h"
 #include "app/scan_stages.h"
@@ -191,7 +192,7 @@ int Run(const Args& args) {
   ihs::app::SequentialScan scan(args.input, RunOptionsFrom(args));
   ihs::app::HandStage hand(options, scan.intrinsics());
   ihs::app::ObjectStage object_stage(options, scan.intrinsics());
-  ihs::app::ScanRecord record(hand.BoneNames());
+  ihs::app::ScanRecord record(hand.BoneNames(), hand.AngleNames());
   const fs::path out = args.out;
   PrepareOutput(out);
 
@@ -218,10 +219,18 @@ int Run(const Args& args) {
   record.WriteTables(out);
 
   const nlohmann::json summary = record.Summary();
-  nlohmann::json extra = {
-      {"hand_scale", hand.scale()},    {"hand_scale_at_bound", hand.scale_at_bound()},
-      {"gamma_t", args.gamma_t},       {"icp", !args.no_icp},
-      {"visual", !args.contacts_only}, {"seconds", run_s}};
+  // The options in effect (the flags and --set together), not the flags alone.
+  const ihs::app::RunRecord run = ihs::app::RunRecord::Of(args.input, options);
+  run.WriteOptions(out);
+  const bool visual = (options.scan.features_2d || options.scan.features_3d) &&
+                      options.fusion.pairwise.visual_weight > 0;
+  nlohmann::json extra = {{"hand_scale", hand.scale()},
+                          {"hand_scale_at_bound", hand.scale_at_bound()},
+                          {"gamma_t", options.fusion.pairwise.contact_weight},
+                          {"icp", options.fusion.use_icp},
+                          {"visual", visual},
+                          {"seconds", run_s},
+                          {"run", run.Json(scan.intrinsics())}};
   extra.update(MeshSummary(exported.meshes, export_ms, marching_cubes_ms));
   PrintSummary(frames, record, summary, exported.meshes, export_ms, marching_cubes_ms, out);
   if (!args.gt.empty()) {

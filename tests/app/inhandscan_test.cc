@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "core/mesh_io.h"
 #include "sensor/oni_writer.h"
@@ -202,6 +203,42 @@ TEST_F(InhandscanSignalTest, ReplayWritesEveryOutputAndTheFormatsAskedFor) {
   }
   // A preview every 30 fused frames.
   EXPECT_FALSE(fs::is_empty(out / "preview"));
+}
+
+// The output folder records the run: the options in effect (flags and --set) as options.conf,
+// which --config reads back to make the same mesh; stats.json names the version, commit, input
+// and camera; hand_poses.csv names every column.
+TEST_F(InhandscanSignalTest, TheRunRecordReadBackByConfigMakesTheSameMesh) {
+  test::TempDir dir;
+  const std::string input = (*dir_ / "sequence.oni").string();
+  const auto first = RunApp("replay " + input + " --out " + (dir / "first").string() +
+                            " --set pipeline.max_frames=31 --set fusion.pairwise.contact_weight=12"
+                            " --set pipeline.preview_every=0 --quiet");
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const std::string options = test::ReadFileString(dir / "first" / "options.conf");
+  EXPECT_NE(options.find("\nfusion.pairwise.contact_weight = 12\n"), std::string::npos);
+  EXPECT_NE(options.find("\npipeline.max_frames = 31\n"), std::string::npos);
+  const auto run = nlohmann::json::parse(test::ReadFileString(dir / "first" / "stats.json"));
+  const auto& record = run["summary"]["run"];
+  EXPECT_EQ(record["version"], IHS_VERSION);
+  EXPECT_FALSE(record["commit"].get<std::string>().empty());
+  EXPECT_NE(record["input"].get<std::string>().find(input), std::string::npos) << record;
+  EXPECT_EQ(record["intrinsics"]["fx"].get<double>(), 525.0);
+  EXPECT_EQ(record["intrinsics"]["width"].get<int>(), 640);
+
+  const auto again = RunApp("replay " + input + " --out " + (dir / "again").string() +
+                            " --config " + (dir / "first" / "options.conf").string() + " --quiet");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(test::ReadFileString(dir / "again" / "mesh.ply"),
+            test::ReadFileString(dir / "first" / "mesh.ply"));
+
+  std::istringstream poses(test::ReadFileString(dir / "first" / "hand_poses.csv"));
+  std::string comment, header, row;
+  ASSERT_TRUE(std::getline(poses, comment) && std::getline(poses, header) &&
+              std::getline(poses, row));
+  EXPECT_EQ(header.find("angles..."), std::string::npos) << header;
+  EXPECT_NE(header.find(",RFing.3_1.y,"), std::string::npos) << header;
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','), std::count(row.begin(), row.end(), ','));
 }
 
 // SIGINT (Ctrl-C) and SIGHUP (the terminal closed) both end the scan with its model saved.

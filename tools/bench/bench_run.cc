@@ -283,7 +283,7 @@ CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
   for (const Method& method : methods) {
     Runner runner{method, OptionsFor(method), nullptr, nullptr};
     runner.stage = std::make_unique<app::ObjectStage>(runner.options, scan.intrinsics());
-    runner.record = std::make_unique<app::ScanRecord>(hand.BoneNames());
+    runner.record = std::make_unique<app::ScanRecord>(hand.BoneNames(), hand.AngleNames());
     runners.push_back(std::move(runner));
   }
   std::unique_ptr<Open3dBaseline> open3d;
