@@ -13,6 +13,8 @@
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -28,10 +30,12 @@
 #include "core/exit_codes.h"
 #include "core/logging.h"
 #include "render/live_window.h"
+#include "sensor/intrinsics_override.h"
 #include "sensor/open_input.h"
 #include "sensor/openni_recorder.h"
 #include "sensor/openni_source.h"
 #include "sensor/paced_source.h"
+#include "sensor/tum_directory.h"
 #include "sensor/usb_devices.h"
 
 namespace {
@@ -84,7 +88,33 @@ struct ScanArgs {
   int loops = 1;
   std::string device;
   std::string input;
+  std::string intrinsics;  // --intrinsics FILE
+  double depth_scale = 0;  // --depth-scale, units per metre (0: the input's own)
 };
+
+// The input's source with the camera options: for an image folder, its intrinsics and depth
+// scale; for a recording or a device, the intrinsics in place of its own (its depth is in mm).
+std::unique_ptr<ihs::sensor::FrameSource> OpenWithCamera(
+    const ScanArgs& args, ihs::sensor::InputOptions options,
+    const std::function<
+        std::unique_ptr<ihs::sensor::FrameSource>(const ihs::sensor::InputOptions&)>& open) {
+  const bool folder = !args.input.empty() && std::filesystem::is_directory(args.input);
+  if (args.depth_scale > 0) {
+    if (!folder) {
+      throw std::invalid_argument(
+          "--depth-scale applies to image folders (TUM or Open3D's); a recording's or a "
+          "camera's depth is in millimetres");
+    }
+    options.tum.depth_scale_per_m = options.tum.open3d_depth_scale_per_m = args.depth_scale;
+  }
+  if (args.intrinsics.empty()) return open(options);
+  const ihs::CameraIntrinsics intrinsics = ihs::sensor::ReadIntrinsicsFile(args.intrinsics);
+  if (folder) {
+    options.tum.intrinsics = intrinsics;
+    return open(options);
+  }
+  return std::make_unique<ihs::sensor::IntrinsicsOverride>(open(options), intrinsics);
+}
 
 std::string StatusLine(const ihs::app::PipelineProgress& progress) {
   char line[256];
@@ -301,10 +331,21 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"obj", "stl", "ply"}))
         ->delimiter(',');
   };
+  auto add_camera = [&](CLI::App* command) {
+    command->add_option("--intrinsics", args.intrinsics,
+                        "the camera's intrinsics: a file of 'fx fy cx cy width height', or "
+                        "Open3D's PinholeCameraIntrinsic JSON (default: the input's own)");
+    command
+        ->add_option("--depth-scale", args.depth_scale,
+                     "depth image units per metre of an image folder (default: TUM 5000, "
+                     "Open3D's layout 1000)")
+        ->check(CLI::Range(1.0, 1e6));
+  };
   CLI::App* live = app.add_subcommand("live", "scan with a Carmine 1.09 (or any OpenNI2 camera)");
   live->add_option("--device", args.device, "device URI (default: the first one)");
   live->add_flag("--no-window", args.no_window, "headless: export on SIGUSR1, stop on Ctrl-C");
   add_output(live);
+  add_camera(live);
   CLI::App* replay =
       app.add_subcommand("replay", "scan a recording (.oni or TUM folder), headless");
   replay->add_option("input", args.input, ".oni file or TUM RGB-D folder")->required();
@@ -316,6 +357,7 @@ int main(int argc, char** argv) {
                    "play the recording this many times over, as one long input (a soak run)")
       ->check(CLI::Range(1, 1000));
   add_output(replay);
+  add_camera(replay);
   std::string record_path;
   double record_seconds = 0;
   CLI::App* record = app.add_subcommand("record", "record the camera to an .oni file");
@@ -383,14 +425,18 @@ int main(int argc, char** argv) {
     if (live->parsed()) {
       ihs::sensor::OpenNiOptions device;
       device.uri = args.device;
-      return Scan(std::make_unique<ihs::sensor::OpenNiSource>(device), options, args,
-                  !args.no_window, quiet);
+      auto camera = OpenWithCamera(args, {}, [&](const ihs::sensor::InputOptions&) {
+        return std::make_unique<ihs::sensor::OpenNiSource>(device);
+      });
+      return Scan(std::move(camera), options, args, !args.no_window, quiet);
     }
     ihs::sensor::InputOptions input_options;
     input_options.pacing =
         args.realtime ? ihs::sensor::Pacing::kRealTime : ihs::sensor::Pacing::kAsFastAsPossible;
     input_options.loops = args.loops;
-    return Scan(ihs::sensor::OpenInput(args.input, input_options), options, args, args.window,
-                quiet);
+    auto input = OpenWithCamera(args, input_options, [&](const ihs::sensor::InputOptions& with) {
+      return ihs::sensor::OpenInput(args.input, with);
+    });
+    return Scan(std::move(input), options, args, args.window, quiet);
   });
 }

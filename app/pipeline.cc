@@ -162,6 +162,9 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
   }
   shared_ = std::make_unique<Shared>(options_.pipeline.queue_capacity, source_->IsLive());
   shared_->intrinsics = source_->Intrinsics();
+  const CameraIntrinsics& camera = shared_->intrinsics;
+  spdlog::info("camera: {}x{} pixels, fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}", camera.width,
+               camera.height, camera.fx, camera.fy, camera.cx, camera.cy);
   shared_->hand = std::make_unique<HandStage>(options_, shared_->intrinsics);
   shared_->bone_names = shared_->hand->BoneNames();
   shared_->angle_names = shared_->hand->AngleNames();

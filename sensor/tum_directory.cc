@@ -3,10 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -134,6 +136,74 @@ std::vector<TumEntry> ReadAssociations(const fs::path& file) {
   return entries;
 }
 
+// The colour folder of Open3D's layout, or empty.
+fs::path Open3dColorFolder(const fs::path& folder) {
+  for (const char* name : {"color", "image", "rgb"}) {
+    if (fs::is_directory(folder / name)) return folder / name;
+  }
+  return {};
+}
+
+// The image files of `folder` (PNG or JPEG), sorted by name, relative to its parent.
+std::vector<std::string> SortedImages(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+    std::string extension = entry.path().extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    if (entry.is_regular_file() &&
+        (extension == ".png" || extension == ".jpg" || extension == ".jpeg")) {
+      names.push_back((folder.filename() / entry.path().filename()).string());
+    }
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Open3D's layout: the n-th depth image with the n-th colour image, 30 frames per second.
+std::vector<TumEntry> ListOpen3dFolder(const fs::path& folder, int* unmatched) {
+  const std::vector<std::string> depth = SortedImages(folder / "depth");
+  const std::vector<std::string> color = SortedImages(Open3dColorFolder(folder));
+  if (depth.size() != color.size()) {
+    spdlog::warn("{}: {} depth and {} colour images: pairing the first {} by name", folder.string(),
+                 depth.size(), color.size(), std::min(depth.size(), color.size()));
+  }
+  std::vector<TumEntry> entries;
+  for (size_t i = 0; i < std::min(depth.size(), color.size()); ++i) {
+    const double time_s = static_cast<double>(i) / 30.0;
+    entries.push_back({time_s, depth[i], time_s, color[i]});
+  }
+  if (unmatched && depth.size() > color.size()) {
+    *unmatched = static_cast<int>(depth.size() - color.size());
+  }
+  return entries;
+}
+
+// Open3D's PinholeCameraIntrinsic JSON: width, height and the column-major 3x3 matrix.
+CameraIntrinsics ParseOpen3dIntrinsics(const std::string& text, const fs::path& path) {
+  const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+  const bool valid = json.is_object() && json.contains("width") && json["width"].is_number() &&
+                     json.contains("height") && json["height"].is_number() &&
+                     json.contains("intrinsic_matrix") && json["intrinsic_matrix"].is_array() &&
+                     json["intrinsic_matrix"].size() == 9 &&
+                     std::all_of(json["intrinsic_matrix"].begin(), json["intrinsic_matrix"].end(),
+                                 [](const nlohmann::json& v) { return v.is_number(); });
+  if (!valid) {
+    throw InputError(path.string() +
+                     ": expected Open3D's intrinsics JSON (width, height, intrinsic_matrix of 9 "
+                     "numbers)");
+  }
+  const auto& m = json["intrinsic_matrix"];
+  CameraIntrinsics intrinsics;
+  intrinsics.width = json["width"].get<int>();
+  intrinsics.height = json["height"].get<int>();
+  intrinsics.fx = m[0].get<double>();
+  intrinsics.fy = m[4].get<double>();
+  intrinsics.cx = m[6].get<double>();
+  intrinsics.cy = m[7].get<double>();
+  return intrinsics;
+}
+
 std::string FormatTime(std::int64_t timestamp_us) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.6f", timestamp_us / 1e6);
@@ -145,6 +215,8 @@ std::string FormatTime(std::int64_t timestamp_us) {
 void TumOptions::Check() const {
   IHS_CHECK_ARG(depth_scale_per_m > 0 && std::isfinite(depth_scale_per_m),
                 "depth_scale_per_m must be positive, got " << depth_scale_per_m);
+  IHS_CHECK_ARG(open3d_depth_scale_per_m > 0 && std::isfinite(open3d_depth_scale_per_m),
+                "open3d_depth_scale_per_m must be positive, got " << open3d_depth_scale_per_m);
   IHS_CHECK_ARG(max_time_difference_s >= 0,
                 "max_time_difference_s must not be negative, got " << max_time_difference_s);
   if (intrinsics) intrinsics->Check();
@@ -157,9 +229,11 @@ std::vector<TumEntry> ListTumDirectory(const fs::path& folder, const TumOptions&
   if (fs::exists(folder / "associations.txt")) {
     return ReadAssociations(folder / "associations.txt");
   }
+  if (IsOpen3dFolder(folder)) return ListOpen3dFolder(folder, unmatched);
   if (!fs::exists(folder / "depth.txt") || !fs::exists(folder / "rgb.txt")) {
     throw InputError(folder.string() +
-                     ": not a TUM RGB-D folder (needs depth.txt and rgb.txt, or associations.txt)");
+                     ": not a TUM RGB-D folder (needs depth.txt and rgb.txt, or associations.txt) "
+                     "nor one of Open3D's (depth/ and color/)");
   }
   std::vector<Stamped> depth = ReadList(folder / "depth.txt");
   std::vector<Stamped> color = ReadList(folder / "rgb.txt");
@@ -199,12 +273,24 @@ std::vector<TumEntry> ListTumDirectory(const fs::path& folder, const TumOptions&
   return entries;
 }
 
+bool IsOpen3dFolder(const fs::path& folder) {
+  return !fs::exists(folder / "associations.txt") && !fs::exists(folder / "depth.txt") &&
+         fs::is_directory(folder / "depth") && !Open3dColorFolder(folder).empty();
+}
+
 CameraIntrinsics ReadIntrinsicsFile(const fs::path& path) {
-  std::istringstream fields(ReadFileToString(path));
+  const std::string text = ReadFileToString(path);
+  const size_t first = text.find_first_not_of(" \t\r\n");
   CameraIntrinsics intrinsics;
-  if (!(fields >> intrinsics.fx >> intrinsics.fy >> intrinsics.cx >> intrinsics.cy >>
-        intrinsics.width >> intrinsics.height)) {
-    throw InputError(path.string() + ": expected 'fx fy cx cy width height'");
+  if (first != std::string::npos && text[first] == '{') {
+    intrinsics = ParseOpen3dIntrinsics(text, path);
+  } else {
+    std::istringstream fields(text);
+    if (!(fields >> intrinsics.fx >> intrinsics.fy >> intrinsics.cx >> intrinsics.cy >>
+          intrinsics.width >> intrinsics.height)) {
+      throw InputError(path.string() +
+                       ": expected 'fx fy cx cy width height' or Open3D's intrinsics JSON");
+    }
   }
   try {
     intrinsics.Check();
@@ -261,11 +347,19 @@ void TumDirectorySource::Start() {
     spdlog::warn("{}: {} depth images have no colour image within {} s and are left out",
                  folder_.string(), unmatched_, options_.max_time_difference_s);
   }
+  depth_scale_per_m_ =
+      IsOpen3dFolder(folder_) ? options_.open3d_depth_scale_per_m : options_.depth_scale_per_m;
   if (options_.intrinsics) {
     intrinsics_ = *options_.intrinsics;
   } else if (fs::exists(folder_ / "intrinsics.txt")) {
     intrinsics_ = ReadIntrinsicsFile(folder_ / "intrinsics.txt");
+  } else if (fs::exists(folder_ / "camera_intrinsic.json")) {
+    intrinsics_ = ReadIntrinsicsFile(folder_ / "camera_intrinsic.json");
   } else {
+    spdlog::warn(
+        "{}: no intrinsics (no intrinsics.txt or camera_intrinsic.json, no --intrinsics): "
+        "assuming a Carmine 1.09's; give the camera's with --intrinsics FILE",
+        folder_.string());
     intrinsics_ = CameraIntrinsics::Carmine109();
     std::string problem;
     const cv::Mat first =
@@ -307,7 +401,7 @@ SourceRead TumDirectorySource::Next(std::chrono::milliseconds) {
       continue;
     }
     auto frame = std::make_shared<Frame>(Frame::Blank(depth.cols, depth.rows));
-    const double mm_per_unit = 1000.0 / options_.depth_scale_per_m;
+    const double mm_per_unit = 1000.0 / depth_scale_per_m_;
     for (int v = 0; v < depth.rows; ++v) {
       const auto* row = depth.ptr<std::uint16_t>(v);
       for (int u = 0; u < depth.cols; ++u) {

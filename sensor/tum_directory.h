@@ -3,6 +3,11 @@
 // `depth.txt` ("timestamp path" lines, '#' comments), optionally `associations.txt`; depth is a
 // 16-bit PNG scaled by `depth_scale_per_m` (5000 per metre, i.e. 0.2 mm per unit); colour is
 // PNG or JPEG. We also read and write `intrinsics.txt` ("fx fy cx cy width height").
+//
+// Also read: the folders Open3D's tools write (its RealSense and Azure Kinect recorders, its
+// reconstruction system's datasets): `depth/` and `color/` (or `image/`, `rgb/`) images paired
+// by sorted file name, 30 frames per second, depth at `open3d_depth_scale_per_m` (1000: mm),
+// intrinsics in `camera_intrinsic.json` (Open3D's PinholeCameraIntrinsic JSON).
 
 #include <cstdint>
 #include <filesystem>
@@ -18,9 +23,12 @@ namespace ihs::sensor {
 struct TumOptions {
   /// Depth PNG units per metre (TUM: 5000, so 1 unit = 0.2 mm).
   double depth_scale_per_m = 5000.0;
+  /// The same for a folder in Open3D's layout (its recorders write millimetres: 1000).
+  double open3d_depth_scale_per_m = 1000.0;
   /// Largest depth/colour timestamp difference for a pair, seconds (TUM's associate.py: 0.02).
   double max_time_difference_s = 0.02;
-  /// Intrinsics to use; when unset, `intrinsics.txt` in the folder, else the Carmine defaults.
+  /// Intrinsics to use; when unset, `intrinsics.txt` or `camera_intrinsic.json` in the folder,
+  /// else the Carmine 1.09's (with a warning).
   std::optional<CameraIntrinsics> intrinsics;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -66,6 +74,7 @@ class TumDirectorySource : public FrameSource {
   const TumOptions options_;
   std::vector<TumEntry> entries_;
   CameraIntrinsics intrinsics_;
+  double depth_scale_per_m_ = 0;  // The folder's layout's (TUM's or Open3D's).
   size_t next_ = 0;
   std::int64_t delivered_ = 0;
   std::int64_t skipped_ = 0;
@@ -95,7 +104,13 @@ class TumWriter {
   bool finished_ = false;
 };
 
-/// Reads "fx fy cx cy width height" (an intrinsics.txt); throws ihs::InputError if malformed.
+/// Whether `folder` is in Open3D's layout: no TUM lists, a `depth/` folder and a `color/`,
+/// `image/` or `rgb/` one.
+bool IsOpen3dFolder(const std::filesystem::path& folder);
+
+/// Reads an intrinsics file: "fx fy cx cy width height" (an intrinsics.txt), or Open3D's
+/// PinholeCameraIntrinsic JSON ({"width", "height", "intrinsic_matrix": the 3x3 matrix in
+/// column-major order}); throws ihs::InputError naming the file if malformed.
 CameraIntrinsics ReadIntrinsicsFile(const std::filesystem::path& path);
 /// Parses "fx,fy,cx,cy[,width,height]" (a command-line value); throws std::invalid_argument.
 CameraIntrinsics ParseIntrinsics(const std::string& text);

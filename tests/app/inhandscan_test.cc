@@ -57,11 +57,35 @@ TEST(InhandscanTest, BadUsageGetsOneLineAndCodeTwo) {
   for (const char* arguments :
        {"", "replay", "frobnicate", "config --set fusion.nonsense=1",
         "config --set fusion.tsdf.resolution=many", "config --set pipeline.queue_capacity=0",
-        "replay x.oni --format gif", "config --config /nonexistent/inhandscan.conf"}) {
+        "replay x.oni --format gif", "config --config /nonexistent/inhandscan.conf",
+        // A recording's depth is in mm: a depth scale is for image folders only.
+        "replay x.oni --depth-scale 1000", "replay folder --depth-scale 0"}) {
     const auto run = RunApp(arguments);
     const int expected = std::string(arguments).find("nonexistent") != std::string::npos ? 3 : 2;
     EXPECT_EQ(run.exit_code, expected) << arguments << ": " << run.err;
     EXPECT_EQ(Lines(run.err), 1) << arguments << ": " << run.err;
+  }
+}
+
+// The camera's intrinsics given in place of a recording's own: a file of the wrong image size or
+// not an intrinsics file is refused in one line (code 3) before anything is scanned.
+TEST(InhandscanTest, GivenIntrinsicsMustFitTheFramesAndParse) {
+  test::TempDir dir;
+  sensor::OniWriterOptions options;
+  options.intrinsics = CameraIntrinsics::Carmine109().Scaled(160, 120);
+  sensor::OniWriter writer(dir / "a.oni", options);
+  for (const Frame& frame : test::MakePatternFrames(2, 160, 120)) writer.Write(frame);
+  writer.Close();
+  test::WriteBytes(dir / "vga.txt", "525 525 319.5 239.5 640 480\n");
+  test::WriteBytes(dir / "bad.json", R"({"width": 160})");
+  for (const char* file : {"vga.txt", "bad.json"}) {
+    const auto run = RunApp("replay " + (dir / "a.oni").string() + " --intrinsics " +
+                            (dir / file).string() + " --out " + (dir / "out").string());
+    EXPECT_EQ(run.exit_code, 3) << file << ": " << run.err;
+    EXPECT_EQ(Lines(run.err), 1) << file << ": " << run.err;
+    EXPECT_NE(run.err.find(file == std::string("vga.txt") ? "640x480" : "bad.json"),
+              std::string::npos)
+        << run.err;
   }
 }
 

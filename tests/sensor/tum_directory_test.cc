@@ -4,8 +4,10 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
@@ -193,6 +195,67 @@ TEST(TumDirectoryTest, ParsesIntrinsicsFromTheCommandLine) {
   EXPECT_THROW(ParseIntrinsics("570,570,320"), std::invalid_argument);
   EXPECT_THROW(ParseIntrinsics("570,abc,320,240"), std::invalid_argument);
   EXPECT_THROW(ParseIntrinsics("-570,570,320,240"), std::invalid_argument);
+}
+
+TEST(TumDirectoryTest, ReadsIntrinsicsFilesInBothForms) {
+  test::TempDir dir;
+  test::WriteBytes(dir / "plain.txt", "570.5 571 320 240 640 480\n");
+  EXPECT_DOUBLE_EQ(ReadIntrinsicsFile(dir / "plain.txt").fy, 571);
+  // Open3D's PinholeCameraIntrinsic JSON: the matrix in column-major order.
+  test::WriteBytes(dir / "open3d.json",
+                   R"({"width": 848, "height": 480, "intrinsic_matrix": )"
+                   R"([421.5, 0.0, 0.0, 0.0, 420.25, 0.0, 424.0, 238.5, 1.0]})");
+  const CameraIntrinsics k = ReadIntrinsicsFile(dir / "open3d.json");
+  EXPECT_EQ(k.width, 848);
+  EXPECT_EQ(k.height, 480);
+  EXPECT_DOUBLE_EQ(k.fx, 421.5);
+  EXPECT_DOUBLE_EQ(k.fy, 420.25);
+  EXPECT_DOUBLE_EQ(k.cx, 424.0);
+  EXPECT_DOUBLE_EQ(k.cy, 238.5);
+  for (const char* bad : {R"({"width": 640})",
+                          R"({"width": 640, "height": 480, )"
+                          R"("intrinsic_matrix": [1, 2, 3]})",
+                          "{not json", "570 570 320"}) {
+    test::WriteBytes(dir / "bad", bad);
+    EXPECT_THROW(ReadIntrinsicsFile(dir / "bad"), InputError) << bad;
+  }
+}
+
+// The folders Open3D's recorders write: depth/ and color/ paired by name, depth in mm, the
+// intrinsics in camera_intrinsic.json.
+TEST(TumDirectoryTest, ReadsOpen3dsLayout) {
+  test::TempDir dir;
+  const auto frames = test::MakePatternFrames(3, 32, 24);
+  std::filesystem::create_directories(dir / "depth");
+  std::filesystem::create_directories(dir / "color");
+  for (size_t i = 0; i < frames.size(); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06zu", i);
+    const Frame& f = frames[i];
+    cv::Mat depth(f.height, f.width, CV_16UC1, const_cast<std::uint16_t*>(f.depth_mm.data()));
+    cv::Mat rgb(f.height, f.width, CV_8UC3, const_cast<std::uint8_t*>(f.rgb.data())), bgr;
+    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+    ASSERT_TRUE(cv::imwrite((dir / "depth" / (std::string(name) + ".png")).string(), depth));
+    ASSERT_TRUE(cv::imwrite((dir / "color" / (std::string(name) + ".png")).string(), bgr));
+  }
+  EXPECT_TRUE(IsOpen3dFolder(dir.path()));
+  test::WriteBytes(dir / "camera_intrinsic.json",
+                   R"({"width": 32, "height": 24, "intrinsic_matrix": )"
+                   R"([26.0, 0, 0, 0, 26.5, 0, 15.5, 11.5, 1]})");
+  TumDirectorySource source(dir.path());
+  const auto read = test::ReadAllFrames(source);
+  ASSERT_EQ(read.size(), frames.size());
+  EXPECT_DOUBLE_EQ(source.Intrinsics().fy, 26.5);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(read[i]->depth_mm, frames[i].depth_mm) << i;  // Millimetres, unscaled.
+    EXPECT_EQ(read[i]->rgb, frames[i].rgb) << i;
+    EXPECT_EQ(read[i]->index, static_cast<std::int64_t>(i));
+  }
+  // Without its intrinsics file, the default camera's, scaled to the images (with a warning).
+  std::filesystem::remove(dir / "camera_intrinsic.json");
+  TumDirectorySource defaults(dir.path());
+  defaults.Start();
+  EXPECT_EQ(defaults.Intrinsics().width, 32);
 }
 
 }  // namespace
