@@ -88,6 +88,7 @@ struct ScanArgs {
   int loops = 1;
   std::string device;
   std::string input;
+  std::string trajectory_format = "mm";
   std::string intrinsics;  // --intrinsics FILE
   double depth_scale = 0;  // --depth-scale, units per metre (0: the input's own)
 };
@@ -280,6 +281,7 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   ihs::app::PipelineOutput output;
   output.folder = args.out.empty() ? DefaultOutputFolder() : args.out;
   output.extra_formats = args.formats;
+  output.trajectory_format = ihs::app::ParseTrajectoryFormat(args.trajectory_format);
   output.live_view = want_window;
   const double stop_grace_s = options.pipeline.stop_grace_s;
   Pipeline pipeline(std::move(source), std::move(options), output);
@@ -330,6 +332,12 @@ int main(int argc, char** argv) {
     command->add_option("--format", args.formats, "also write the mesh as obj and/or stl")
         ->check(CLI::IsMember({"obj", "stl", "ply"}))
         ->delimiter(',');
+    command
+        ->add_option("--trajectory-format", args.trajectory_format,
+                     "trajectory.txt as mm (cam_from_object, millimetres) or tum-m (the camera's "
+                     "pose in the object's frame, metres: TUM's and evo's tools)")
+        ->check(CLI::IsMember({"mm", "tum-m"}))
+        ->capture_default_str();
   };
   auto add_camera = [&](CLI::App* command) {
     command->add_option("--intrinsics", args.intrinsics,

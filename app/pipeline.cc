@@ -179,7 +179,7 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
     spdlog::info("{}: removed {} files of an earlier scan", output_.folder.string(), removed);
   }
   run_record_ = RunRecord::Of(source_->Description(), options_);
-  run_record_.WriteOptions(output_.folder);
+  run_record_.Write(output_.folder, shared_->intrinsics);
   shared_->start = SteadyClock::now();
   started_ = true;
   shared_->running = 4;
@@ -405,7 +405,7 @@ void Pipeline::ExportLoop() {
       const bool final = job->kind == ExportJob::Kind::kFinal;
       const ExportedMeshes exported =
           ExportMeshes(job->model, options_.meshing, output_.folder, output_.extra_formats);
-      job->record->WriteTables(output_.folder);
+      job->record->WriteTables(output_.folder, output_.trajectory_format);
       const PipelineProgress progress = Progress();
       nlohmann::json extra = {{"source", source_->Description()},
                               {"run", run_record_.Json(s.intrinsics)},

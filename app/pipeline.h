@@ -30,6 +30,7 @@
 
 #include "app/preview.h"
 #include "app/run_record.h"
+#include "app/scan_record.h"
 #include "app/scanner_options.h"
 #include "core/latest_value.h"
 #include "sensor/frame_source.h"
@@ -43,6 +44,8 @@ struct PipelineOutput {
   std::filesystem::path folder;
   /// Extra formats of the watertight mesh: "obj", "stl".
   std::vector<std::string> extra_formats;
+  /// How trajectory.txt is written.
+  TrajectoryFormat trajectory_format = TrajectoryFormat::kCamFromObjectMm;
   /// Publish a LiveView for a window (costs a raycast of the model every few frames).
   bool live_view = false;
 };

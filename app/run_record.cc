@@ -2,6 +2,7 @@
 
 #include "app/build_info.h"
 #include "core/atomic_file.h"
+#include "sensor/tum_directory.h"
 
 namespace ihs::app {
 
@@ -10,11 +11,13 @@ RunRecord RunRecord::Of(std::string input, const ScannerOptions& options) {
   return {std::move(input), RegisterScannerOptions(&described).Describe()};
 }
 
-void RunRecord::WriteOptions(const std::filesystem::path& folder) const {
+void RunRecord::Write(const std::filesystem::path& folder,
+                      const CameraIntrinsics& intrinsics) const {
   const std::string header = std::string("# The options in effect (inhandscan ") + BuildVersion() +
                              ", commit " + BuildCommit() + ") for " + input +
                              "; run the same scan again with --config " + kOptionsFile + "\n";
   WriteFileAtomically(folder / kOptionsFile, header + options);
+  WriteFileAtomically(folder / kIntrinsicsFile, sensor::Open3dIntrinsicsJson(intrinsics));
 }
 
 nlohmann::json RunRecord::Json(const CameraIntrinsics& intrinsics) const {
@@ -28,7 +31,8 @@ nlohmann::json RunRecord::Json(const CameraIntrinsics& intrinsics) const {
             {"cy", intrinsics.cy},
             {"width", intrinsics.width},
             {"height", intrinsics.height}}},
-          {"options_file", kOptionsFile}};
+          {"options_file", kOptionsFile},
+          {"intrinsics_file", kIntrinsicsFile}};
 }
 
 }  // namespace ihs::app

@@ -1,7 +1,8 @@
 #pragma once
 // What a scan's output folder says about the run that made it: the version and commit, the
 // input read, its camera and the options in effect — `options.conf`, a file that `--config`
-// reads back to run the same scan again, and a "run" entry in stats.json naming them.
+// reads back to run the same scan again, `camera_intrinsic.json` (Open3D's intrinsics JSON, which
+// `--intrinsics` reads too), and a "run" entry in stats.json naming them.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -22,11 +23,13 @@ struct RunRecord {
   /// The options in effect as a config file (OptionRegistry::Describe()).
   std::string options;
 
-  /// The file name of the options in the output folder.
+  /// The files' names in the output folder.
   static constexpr const char* kOptionsFile = "options.conf";
+  static constexpr const char* kIntrinsicsFile = "camera_intrinsic.json";
 
-  /// Writes `kOptionsFile` into `folder` (atomically), headed by the version, commit and input.
-  void WriteOptions(const std::filesystem::path& folder) const;
+  /// Writes `kOptionsFile` (headed by the version, commit and input) and `kIntrinsicsFile` into
+  /// `folder`, atomically.
+  void Write(const std::filesystem::path& folder, const CameraIntrinsics& intrinsics) const;
   /// stats.json's "run": version, commit, input, the camera's intrinsics, the options file.
   nlohmann::json Json(const CameraIntrinsics& intrinsics) const;
 };

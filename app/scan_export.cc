@@ -33,9 +33,9 @@ ExportedMeshes ExportMeshes(const fusion::ModelSnapshot& model,
 
 namespace {
 
-constexpr const char* kScanFiles[] = {"mesh.ply",       "mesh_tsdf.ply",  "mesh.obj",
-                                      "mesh.stl",       "trajectory.txt", "hand_joints.csv",
-                                      "hand_poses.csv", "stats.json",     "options.conf"};
+constexpr const char* kScanFiles[] = {
+    "mesh.ply",        "mesh_tsdf.ply",  "mesh.obj",   "mesh.stl",     "trajectory.txt",
+    "hand_joints.csv", "hand_poses.csv", "stats.json", "options.conf", "camera_intrinsic.json"};
 
 }  // namespace
 

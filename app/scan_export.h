@@ -40,7 +40,7 @@ std::string ScanFileNamesIn(const std::filesystem::path& folder);
 
 /// Removes from `folder` the files an earlier scan wrote there (mesh.ply, mesh_tsdf.ply,
 /// mesh.obj, mesh.stl, trajectory.txt, hand_joints.csv, hand_poses.csv, stats.json,
-/// options.conf and the PNGs
+/// options.conf, camera_intrinsic.json and the PNGs
 /// in preview/), so that a new scan into the same folder never leaves an old mesh beside its own
 /// stats.json; other files stay. Returns how many were removed. Throws ihs::OutputError when one
 /// cannot be removed.

@@ -145,9 +145,28 @@ nlohmann::json ScanRecord::Summary() const {
   return summary;
 }
 
-void ScanRecord::WriteTables(const std::filesystem::path& folder) const {
-  WriteTumTrajectory(folder / "trajectory.txt", trajectory_,
-                     {"cam_from_object of the scanned object (mm), registered frames only"});
+TrajectoryFormat ParseTrajectoryFormat(const std::string& name) {
+  if (name == "mm") return TrajectoryFormat::kCamFromObjectMm;
+  if (name == "tum-m") return TrajectoryFormat::kTumMetres;
+  throw std::invalid_argument("trajectory format '" + name + "': mm or tum-m");
+}
+
+void ScanRecord::WriteTables(const std::filesystem::path& folder,
+                             TrajectoryFormat trajectory) const {
+  if (trajectory == TrajectoryFormat::kCamFromObjectMm) {
+    WriteTumTrajectory(folder / "trajectory.txt", trajectory_,
+                       {"cam_from_object of the scanned object (mm), registered frames only"});
+  } else {
+    std::vector<StampedPose> camera;
+    for (const StampedPose& pose : trajectory_) {
+      const Rigid3 object_from_cam = pose.transform.Inverse();
+      camera.push_back(
+          {pose.time_s, Rigid3(object_from_cam.rotation(), object_from_cam.translation() / 1000)});
+    }
+    WriteTumTrajectory(folder / "trajectory.txt", camera,
+                       {"the camera's pose in the scanned object's frame (object_from_cam, "
+                        "metres), registered frames only"});
+  }
   tracker::WriteHandJointsCsv(folder / "hand_joints.csv", bone_names_, joints_);
   std::string poses =
       "# hand pose per tracked frame: cam_from_root (mm; quaternion x y z w), then the joint "

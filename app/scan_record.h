@@ -16,6 +16,16 @@
 
 namespace ihs::app {
 
+/// How trajectory.txt states the object's motion (TUM lines "time tx ty tz qx qy qz qw").
+enum class TrajectoryFormat {
+  kCamFromObjectMm,  ///< "mm": cam_from_object, millimetres (the default).
+  kTumMetres,  ///< "tum-m": the camera's pose in the object's frame (object_from_cam), metres,
+               ///< as the TUM benchmark's and evo's tools read a camera trajectory.
+};
+
+/// "mm" or "tum-m"; throws std::invalid_argument otherwise.
+TrajectoryFormat ParseTrajectoryFormat(const std::string& name);
+
 /// Per-frame log of a scan.
 class ScanRecord {
  public:
@@ -44,7 +54,8 @@ class ScanRecord {
   nlohmann::json Summary() const;
 
   /// Writes trajectory.txt, hand_joints.csv and hand_poses.csv into `folder`.
-  void WriteTables(const std::filesystem::path& folder) const;
+  void WriteTables(const std::filesystem::path& folder,
+                   TrajectoryFormat trajectory = TrajectoryFormat::kCamFromObjectMm) const;
   /// Writes `path` as {"summary": Summary() merged with `extra`, "frames": [...]}.
   void WriteStats(const std::filesystem::path& path, const nlohmann::json& extra) const;
 

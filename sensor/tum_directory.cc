@@ -300,6 +300,14 @@ CameraIntrinsics ReadIntrinsicsFile(const fs::path& path) {
   return intrinsics;
 }
 
+std::string Open3dIntrinsicsJson(const CameraIntrinsics& k) {
+  const nlohmann::json json = {
+      {"width", k.width},
+      {"height", k.height},
+      {"intrinsic_matrix", {k.fx, 0.0, 0.0, 0.0, k.fy, 0.0, k.cx, k.cy, 1.0}}};
+  return json.dump(1) + "\n";
+}
+
 CameraIntrinsics ParseIntrinsics(const std::string& text) {
   std::vector<double> values;
   std::stringstream fields(text);

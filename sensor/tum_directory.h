@@ -112,6 +112,8 @@ bool IsOpen3dFolder(const std::filesystem::path& folder);
 /// PinholeCameraIntrinsic JSON ({"width", "height", "intrinsic_matrix": the 3x3 matrix in
 /// column-major order}); throws ihs::InputError naming the file if malformed.
 CameraIntrinsics ReadIntrinsicsFile(const std::filesystem::path& path);
+/// `intrinsics` as Open3D's PinholeCameraIntrinsic JSON (what ReadIntrinsicsFile reads back).
+std::string Open3dIntrinsicsJson(const CameraIntrinsics& intrinsics);
 /// Parses "fx,fy,cx,cy[,width,height]" (a command-line value); throws std::invalid_argument.
 CameraIntrinsics ParseIntrinsics(const std::string& text);
 

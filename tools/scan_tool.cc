@@ -221,7 +221,7 @@ int Run(const Args& args) {
   const nlohmann::json summary = record.Summary();
   // The options in effect (the flags and --set together), not the flags alone.
   const ihs::app::RunRecord run = ihs::app::RunRecord::Of(args.input, options);
-  run.WriteOptions(out);
+  run.Write(out, scan.intrinsics());
   const bool visual = (options.scan.features_2d || options.scan.features_3d) &&
                       options.fusion.pairwise.visual_weight > 0;
   nlohmann::json extra = {{"hand_scale", hand.scale()},

@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "core/mesh_io.h"
+#include "core/trajectory_io.h"
 #include "sensor/oni_writer.h"
+#include "sensor/tum_directory.h"
 #include "tests/frame_fixtures.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
@@ -231,7 +233,8 @@ TEST_F(InhandscanSignalTest, ReplayWritesEveryOutputAndTheFormatsAskedFor) {
 
 // The output folder records the run: the options in effect (flags and --set) as options.conf,
 // which --config reads back to make the same mesh; stats.json names the version, commit, input
-// and camera; hand_poses.csv names every column.
+// and camera, camera_intrinsic.json holds it for Open3D; hand_poses.csv names every column; the
+// trajectory in TUM's metres is the millimetre one's inverse.
 TEST_F(InhandscanSignalTest, TheRunRecordReadBackByConfigMakesTheSameMesh) {
   test::TempDir dir;
   const std::string input = (*dir_ / "sequence.oni").string();
@@ -250,11 +253,30 @@ TEST_F(InhandscanSignalTest, TheRunRecordReadBackByConfigMakesTheSameMesh) {
   EXPECT_EQ(record["intrinsics"]["fx"].get<double>(), 525.0);
   EXPECT_EQ(record["intrinsics"]["width"].get<int>(), 640);
 
-  const auto again = RunApp("replay " + input + " --out " + (dir / "again").string() +
-                            " --config " + (dir / "first" / "options.conf").string() + " --quiet");
+  const auto again =
+      RunApp("replay " + input + " --out " + (dir / "again").string() + " --config " +
+             (dir / "first" / "options.conf").string() + " --trajectory-format tum-m --quiet");
   ASSERT_EQ(again.exit_code, 0) << again.err;
   EXPECT_EQ(test::ReadFileString(dir / "again" / "mesh.ply"),
             test::ReadFileString(dir / "first" / "mesh.ply"));
+  const CameraIntrinsics camera =
+      sensor::ReadIntrinsicsFile(dir / "first" / "camera_intrinsic.json");
+  EXPECT_EQ(camera.fx, record["intrinsics"]["fx"].get<double>());
+  EXPECT_EQ(camera.width, record["intrinsics"]["width"].get<int>());
+
+  const auto millimetres = ReadTumTrajectory(dir / "first" / "trajectory.txt");
+  const auto metres = ReadTumTrajectory(dir / "again" / "trajectory.txt");
+  ASSERT_EQ(millimetres.size(), metres.size());
+  ASSERT_GT(millimetres.size(), 20u);
+  for (size_t i = 0; i < metres.size(); ++i) {
+    EXPECT_NEAR(metres[i].time_s, millimetres[i].time_s, 1e-6);
+    const Rigid3 object_from_cam = millimetres[i].transform.Inverse();
+    // The files hold 6 decimals of a metre (1 µm) and 9 of the quaternion.
+    EXPECT_LT((metres[i].transform.translation() * 1000 - object_from_cam.translation()).norm(),
+              0.01)
+        << i;
+    EXPECT_LT((metres[i].transform.rotation() - object_from_cam.rotation()).norm(), 1e-6) << i;
+  }
 
   std::istringstream poses(test::ReadFileString(dir / "first" / "hand_poses.csv"));
   std::string comment, header, row;

@@ -212,6 +212,15 @@ TEST(TumDirectoryTest, ReadsIntrinsicsFilesInBothForms) {
   EXPECT_DOUBLE_EQ(k.fy, 420.25);
   EXPECT_DOUBLE_EQ(k.cx, 424.0);
   EXPECT_DOUBLE_EQ(k.cy, 238.5);
+  // What a scan writes (camera_intrinsic.json) reads back the same.
+  test::WriteBytes(dir / "written.json", Open3dIntrinsicsJson(k));
+  const CameraIntrinsics back = ReadIntrinsicsFile(dir / "written.json");
+  EXPECT_EQ(back.width, k.width);
+  EXPECT_EQ(back.height, k.height);
+  EXPECT_DOUBLE_EQ(back.fx, k.fx);
+  EXPECT_DOUBLE_EQ(back.fy, k.fy);
+  EXPECT_DOUBLE_EQ(back.cx, k.cx);
+  EXPECT_DOUBLE_EQ(back.cy, k.cy);
   for (const char* bad : {R"({"width": 640})",
                           R"({"width": 640, "height": 480, )"
                           R"("intrinsic_matrix": [1, 2, 3]})",
