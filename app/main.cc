@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -115,6 +116,37 @@ std::unique_ptr<ihs::sensor::FrameSource> OpenWithCamera(
     return open(options);
   }
   return std::make_unique<ihs::sensor::IntrinsicsOverride>(open(options), intrinsics);
+}
+
+// Edits (insertions, deletions, substitutions) between `a` and `b`.
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// A first word that is not a subcommand but close to one ("replya"): the one it was meant to be.
+std::optional<std::string> MistypedSubcommand(const CLI::App& app, int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return std::nullopt;
+  const std::string word = argv[1];
+  std::optional<std::string> closest;
+  size_t best = 3;  // At most two edits away.
+  for (const CLI::App* command : app.get_subcommands({})) {
+    const std::string& name = command->get_name();
+    if (name == word) return std::nullopt;
+    const size_t distance = EditDistance(word, name);
+    if (distance < best) best = distance, closest = name;
+  }
+  return closest;
 }
 
 std::string StatusLine(const ihs::app::PipelineProgress& progress) {
@@ -377,6 +409,11 @@ int main(int argc, char** argv) {
   CLI::App* config =
       app.add_subcommand("config", "print every option with its default and meaning");
 
+  if (const auto meant = MistypedSubcommand(app, argc, argv)) {
+    std::fprintf(stderr, "inhandscan: error: unknown command '%s' (did you mean '%s'?)\n", argv[1],
+                 meant->c_str());
+    return ihs::kExitUsage;
+  }
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan", [&]() -> int {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);

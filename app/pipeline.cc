@@ -151,11 +151,30 @@ Pipeline::~Pipeline() {
 void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) {
   if (started_) throw std::logic_error("Pipeline::Start called twice");
   std::error_code error;
+  const bool made_folder = !std::filesystem::exists(output_.folder, error);
   std::filesystem::create_directories(output_.folder, error);
   if (error || !std::filesystem::is_directory(output_.folder)) {
     throw OutputError(output_.folder.string() + ": cannot create the output folder" +
                       (error ? " (" + error.message() + ")" : ""));
   }
+  try {
+    StartStages(initial_hand_pose);
+  } catch (...) {
+    // Nothing was scanned: a folder made for this scan goes again (with its empty preview/).
+    if (made_folder) std::filesystem::remove_all(output_.folder, error);
+    throw;
+  }
+  shared_->start = SteadyClock::now();
+  started_ = true;
+  shared_->running = 4;
+  threads_.emplace_back([this] { CaptureLoop(); });
+  threads_.emplace_back([this] { TrackerLoop(); });
+  threads_.emplace_back([this] { FusionLoop(); });
+  threads_.emplace_back([this] { ExportLoop(); });
+}
+
+void Pipeline::StartStages(const std::optional<tracker::HandPose>& initial_hand_pose) {
+  std::error_code error;
   source_->Start();
   if (options_.pipeline.preview_every > 0) {
     std::filesystem::create_directories(output_.folder / "preview", error);
@@ -180,13 +199,6 @@ void Pipeline::Start(const std::optional<tracker::HandPose>& initial_hand_pose) 
   }
   run_record_ = RunRecord::Of(source_->Description(), options_);
   run_record_.Write(output_.folder, shared_->intrinsics);
-  shared_->start = SteadyClock::now();
-  started_ = true;
-  shared_->running = 4;
-  threads_.emplace_back([this] { CaptureLoop(); });
-  threads_.emplace_back([this] { TrackerLoop(); });
-  threads_.emplace_back([this] { FusionLoop(); });
-  threads_.emplace_back([this] { ExportLoop(); });
 }
 
 void Pipeline::ThreadDone() {

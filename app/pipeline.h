@@ -109,7 +109,8 @@ class Pipeline {
   Pipeline& operator=(const Pipeline&) = delete;
 
   /// Starts the source and the threads. The source's errors (ihs::DeviceError, InputError) and
-  /// an unusable output folder (OutputError) are thrown from here, before any thread runs.
+  /// an unusable output folder (OutputError) are thrown from here, before any thread runs; an
+  /// output folder made for this scan is then removed (no empty folder is left behind).
   /// `initial_hand_pose` starts the tracker from a known pose (benchmark mode).
   void Start(const std::optional<tracker::HandPose>& initial_hand_pose = std::nullopt);
   /// Asks for an export of the model so far; the scan goes on. Safe from any thread.
@@ -147,6 +148,9 @@ class Pipeline {
   void Fail(const std::string& stage, std::exception_ptr error);
   // Every thread's last act: counts it out and wakes Wait().
   void ThreadDone();
+  // Start's steps before the threads: the source, the hand stage, the run record. Throws as
+  // Start does; Start then removes an output folder it made.
+  void StartStages(const std::optional<tracker::HandPose>& initial_hand_pose);
 
   std::unique_ptr<sensor::FrameSource> source_;
   const ScannerOptions options_;

@@ -91,6 +91,33 @@ TEST(InhandscanTest, GivenIntrinsicsMustFitTheFramesAndParse) {
   }
 }
 
+// A mistyped subcommand is named with the one it was meant to be.
+TEST(InhandscanTest, AMistypedSubcommandGetsASuggestion) {
+  const auto run = RunApp("replya x.oni");
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_EQ(Lines(run.err), 1) << run.err;
+  EXPECT_NE(run.err.find("did you mean 'replay'?"), std::string::npos) << run.err;
+}
+
+// `cmake --install` puts the scanner and its tools in a prefix's bin/, and they run from there.
+TEST(InhandscanTest, InstalledToAPrefixItRunsFromThere) {
+  test::TempDir prefix;
+  const auto install = test::RunCommand(std::string("cmake --install '") + IHS_BUILD_DIR +
+                                        "' --prefix '" + prefix.path().string() + "'");
+  ASSERT_EQ(install.exit_code, 0) << install.err;
+  for (const char* tool :
+       {"inhandscan", "inhandscan-frames", "inhandscan-mesh", "inhandscan-measure",
+        "inhandscan-scan", "inhandscan-track", "inhandscan-synth"}) {
+    EXPECT_TRUE(fs::is_regular_file(prefix / "bin" / tool)) << tool;
+  }
+  const auto version = test::RunCommand((prefix / "bin" / "inhandscan").string() + " --version");
+  EXPECT_EQ(version.exit_code, 0) << version.err;
+  EXPECT_NE(version.out.find(IHS_VERSION), std::string::npos) << version.out;
+  const auto config = test::RunCommand((prefix / "bin" / "inhandscan").string() + " config");
+  EXPECT_EQ(config.exit_code, 0) << config.err;
+  EXPECT_NE(config.out.find("fusion.tsdf.resolution = 256"), std::string::npos);
+}
+
 TEST(InhandscanTest, AMissingRecordingIsCodeThree) {
   test::TempDir dir;
   const auto run =
@@ -98,6 +125,7 @@ TEST(InhandscanTest, AMissingRecordingIsCodeThree) {
   EXPECT_EQ(run.exit_code, 3) << run.err;
   EXPECT_EQ(Lines(run.err), 1) << run.err;
   EXPECT_NE(run.err.find("missing.oni"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "out")) << "an empty output folder was left behind";
 }
 
 TEST(InhandscanTest, LiveWithoutACameraSaysSoWithCodeFour) {
