@@ -118,6 +118,30 @@ std::unique_ptr<ihs::sensor::FrameSource> OpenWithCamera(
   return std::make_unique<ihs::sensor::IntrinsicsOverride>(open(options), intrinsics);
 }
 
+// The options `live` and `replay` share: the outputs and the camera.
+void AddScanFlags(CLI::App* command, ScanArgs& args) {
+  command->add_option("--screenshot", args.screenshot,
+                      "save a PNG of the window as it looks when the scan ends");
+  command->add_option("--out", args.out, "output folder (default: scan-DATE-TIME)");
+  command->add_option("--format", args.formats, "also write the mesh as obj and/or stl")
+      ->check(CLI::IsMember({"obj", "stl", "ply"}))
+      ->delimiter(',');
+  command
+      ->add_option("--trajectory-format", args.trajectory_format,
+                   "trajectory.txt as mm (cam_from_object, millimetres) or tum-m (the camera's "
+                   "pose in the object's frame, metres: TUM's and evo's tools)")
+      ->check(CLI::IsMember({"mm", "tum-m"}))
+      ->capture_default_str();
+  command->add_option("--intrinsics", args.intrinsics,
+                      "the camera's intrinsics: a file of 'fx fy cx cy width height', or "
+                      "Open3D's PinholeCameraIntrinsic JSON (default: the input's own)");
+  command
+      ->add_option("--depth-scale", args.depth_scale,
+                   "depth image units per metre of an image folder (default: TUM 5000, "
+                   "Open3D's layout 1000)")
+      ->check(CLI::Range(1.0, 1e6));
+}
+
 // Edits (insertions, deletions, substitutions) between `a` and `b`.
 size_t EditDistance(const std::string& a, const std::string& b) {
   std::vector<size_t> row(b.size() + 1);
@@ -357,38 +381,14 @@ int main(int argc, char** argv) {
   app.add_option("--set", assignments, "set one option: NAME=VALUE (repeatable; after --config)");
 
   ScanArgs args;
-  auto add_output = [&](CLI::App* command) {
-    command->add_option("--screenshot", args.screenshot,
-                        "save a PNG of the window as it looks when the scan ends");
-    command->add_option("--out", args.out, "output folder (default: scan-DATE-TIME)");
-    command->add_option("--format", args.formats, "also write the mesh as obj and/or stl")
-        ->check(CLI::IsMember({"obj", "stl", "ply"}))
-        ->delimiter(',');
-    command
-        ->add_option("--trajectory-format", args.trajectory_format,
-                     "trajectory.txt as mm (cam_from_object, millimetres) or tum-m (the camera's "
-                     "pose in the object's frame, metres: TUM's and evo's tools)")
-        ->check(CLI::IsMember({"mm", "tum-m"}))
-        ->capture_default_str();
-  };
-  auto add_camera = [&](CLI::App* command) {
-    command->add_option("--intrinsics", args.intrinsics,
-                        "the camera's intrinsics: a file of 'fx fy cx cy width height', or "
-                        "Open3D's PinholeCameraIntrinsic JSON (default: the input's own)");
-    command
-        ->add_option("--depth-scale", args.depth_scale,
-                     "depth image units per metre of an image folder (default: TUM 5000, "
-                     "Open3D's layout 1000)")
-        ->check(CLI::Range(1.0, 1e6));
-  };
   CLI::App* live = app.add_subcommand("live", "scan with a Carmine 1.09 (or any OpenNI2 camera)");
   live->add_option("--device", args.device, "device URI (default: the first one)");
   live->add_flag("--no-window", args.no_window, "headless: export on SIGUSR1, stop on Ctrl-C");
-  add_output(live);
-  add_camera(live);
+  AddScanFlags(live, args);
   CLI::App* replay =
-      app.add_subcommand("replay", "scan a recording (.oni or TUM folder), headless");
-  replay->add_option("input", args.input, ".oni file or TUM RGB-D folder")->required();
+      app.add_subcommand("replay", "scan a recording (.oni, TUM or Open3D folder), headless");
+  replay->add_option("input", args.input, ".oni file, TUM RGB-D folder or Open3D folder")
+      ->required();
   replay->add_flag("--realtime", args.realtime,
                    "pace frames at their timestamps and drop frames as live would");
   replay->add_flag("--window", args.window, "show the live window while replaying");
@@ -396,8 +396,7 @@ int main(int argc, char** argv) {
       ->add_option("--loop", args.loops,
                    "play the recording this many times over, as one long input (a soak run)")
       ->check(CLI::Range(1, 1000));
-  add_output(replay);
-  add_camera(replay);
+  AddScanFlags(replay, args);
   std::string record_path;
   double record_seconds = 0;
   CLI::App* record = app.add_subcommand("record", "record the camera to an .oni file");
