@@ -121,7 +121,8 @@ std::unique_ptr<ihs::sensor::FrameSource> OpenWithCamera(
 // The options `live` and `replay` share: the outputs and the camera.
 void AddScanFlags(CLI::App* command, ScanArgs& args) {
   command->add_option("--screenshot", args.screenshot,
-                      "save a PNG of the window as it looks when the scan ends");
+                      "save a PNG of the window as it looks when the scan ends (drawn off-screen "
+                      "when there is no window)");
   command->add_option("--out", args.out, "output folder (default: scan-DATE-TIME)");
   command->add_option("--format", args.formats, "also write the mesh as obj and/or stl")
       ->check(CLI::IsMember({"obj", "stl", "ply"}))
@@ -171,18 +172,6 @@ std::optional<std::string> MistypedSubcommand(const CLI::App& app, int argc, cha
     if (distance < best) best = distance, closest = name;
   }
   return closest;
-}
-
-std::string StatusLine(const ihs::app::PipelineProgress& progress) {
-  char line[256];
-  const double fps = progress.FramesPerSecond();
-  std::snprintf(line, sizeof(line),
-                "%.1f fps | frames %lld fused %lld dropped %lld | seen %.0f %% | hand: %s", fps,
-                static_cast<long long>(progress.processed),
-                static_cast<long long>(progress.registered),
-                static_cast<long long>(progress.dropped), 100 * progress.coverage,
-                progress.tracking.c_str());
-  return line;
 }
 
 // Progress for a person: a line rewritten in place on a terminal, a log line every 10 s
@@ -273,10 +262,10 @@ class StopGuard {
 
 // Runs a pipeline to its end: signals (and the window's keys) become requests; returns the
 // exit code after printing where the mesh is.
-int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
-                ihs::render::LiveWindow* window, const std::string& screenshot, bool quiet,
-                StopGuard& guard) {
+int RunPipeline(Pipeline& pipeline, ihs::render::LiveWindow* window, const std::string& screenshot,
+                bool quiet, StopGuard& guard) {
   ProgressReporter reporter;
+  ihs::app::LiveScreen screen(pipeline, window);
   bool stop_sent = false;
   while (!pipeline.Wait(std::chrono::milliseconds(window ? 15 : 100))) {
     guard.Check(stop_sent);
@@ -289,34 +278,16 @@ int RunPipeline(Pipeline& pipeline, const ihs::CameraIntrinsics& intrinsics,
       pipeline.RequestStop();
       stop_sent = true;
     }
-    const ihs::app::PipelineProgress progress = pipeline.Progress();
-    if (window) {
-      for (char key : window->PollKeys()) {
-        if (key == 's') pipeline.RequestExport();
-        if (key == 'r') pipeline.RequestReset();
-        if (key == 'q' && !stop_sent) pipeline.RequestStop(), stop_sent = true;
-      }
-      if (window->ShouldClose() && !stop_sent) pipeline.RequestStop(), stop_sent = true;
-      if (auto view = pipeline.TakeLiveView()) {
-        const ihs::app::RgbImage screen =
-            ihs::app::ComposeLiveScreen(*view, intrinsics, StatusLine(progress));
-        window->Show(screen.rgb, screen.width, screen.height);
-      }
-    } else if (!quiet) {
-      reporter.Update(progress);
-    }
+    if (screen.Poll() && !stop_sent) pipeline.RequestStop(), stop_sent = true;
+    if (!window && !quiet) reporter.Update(pipeline.Progress());
   }
   reporter.Done();
-  if (window && !screenshot.empty()) {
-    if (auto view = pipeline.TakeLiveView()) {  // The last frames' view, not yet shown.
-      const ihs::app::RgbImage screen =
-          ihs::app::ComposeLiveScreen(*view, intrinsics, StatusLine(pipeline.Progress()));
-      window->Show(screen.rgb, screen.width, screen.height);
+  if (!screenshot.empty()) {
+    try {
+      screen.SaveScreenshot(screenshot);
+    } catch (const ihs::OutputError& error) {  // The scan itself is saved: only say so.
+      spdlog::error("no screenshot: {}", error.what());
     }
-    ihs::app::RgbImage image;
-    image.rgb = window->Screenshot(&image.width, &image.height);
-    ihs::app::WritePng(screenshot, image);
-    spdlog::info("window screenshot: {}", screenshot);
   }
   const ihs::app::PipelineResult result = pipeline.Finish();
   const auto& p = result.progress;
@@ -338,7 +309,7 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   output.folder = args.out.empty() ? DefaultOutputFolder() : args.out;
   output.extra_formats = args.formats;
   output.trajectory_format = ihs::app::ParseTrajectoryFormat(args.trajectory_format);
-  output.live_view = want_window;
+  output.live_view = want_window || !args.screenshot.empty();
   const double stop_grace_s = options.pipeline.stop_grace_s;
   Pipeline pipeline(std::move(source), std::move(options), output);
   pipeline.Start();
@@ -354,7 +325,7 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   spdlog::info("scanning into {} (export now: kill -USR1 {}; stop: Ctrl-C)", output.folder.string(),
                getpid());
   StopGuard guard(pipeline, output.folder, stop_grace_s);
-  return RunPipeline(pipeline, pipeline.intrinsics(), window.get(), args.screenshot, quiet, guard);
+  return RunPipeline(pipeline, window.get(), args.screenshot, quiet, guard);
 }
 
 }  // namespace

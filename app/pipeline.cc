@@ -41,27 +41,6 @@ struct ExportJob {
 };
 using JobPtr = std::unique_ptr<ExportJob>;
 
-// The model seen from the camera, shaded by the angle to the view ray, in its colours, with its
-// depth.
-ModelView ViewModel(const fusion::TsdfVolume& volume, const CameraIntrinsics& intrinsics,
-                    const Rigid3& cam_from_object) {
-  fusion::RaycastImage cast = volume.Raycast(intrinsics, cam_from_object);
-  ModelView view;
-  view.image = {cast.width, cast.height, {}};
-  view.image.rgb.assign(static_cast<std::size_t>(cast.width) * cast.height * 3, 0);
-  for (std::size_t i = 0; i < cast.depth_mm.size(); ++i) {
-    if (cast.depth_mm[i] <= 0) continue;
-    const float shade = 0.25f + 0.75f * std::abs(cast.normals[i].z());
-    const bool colored = i < cast.colors.size();
-    for (int c = 0; c < 3; ++c) {
-      const float base = colored ? cast.colors[i][c] : 200.0f;
-      view.image.rgb[i * 3 + c] = static_cast<std::uint8_t>(std::min(255.0f, base * shade));
-    }
-  }
-  view.depth_mm = std::move(cast.depth_mm);
-  return view;
-}
-
 // The process's peak resident memory so far, MiB.
 double PeakResidentMiB() {
   rusage usage = {};
@@ -121,7 +100,7 @@ struct Pipeline::Shared {
   std::atomic<std::int64_t> dropped_capture{0}, dropped_stale{0}, previews_skipped{0};
   mutable std::mutex mutex;  // Guards what follows.
   std::condition_variable done;
-  std::string tracking = "waiting";
+  std::string hand_state = "waiting", object_state = "waiting";  // FramePacket's, the last.
   std::string end_reason;
   std::string nothing_scanned;  // ScanRecord::NothingScanned() when the scan ends.
   std::string failed_stage;
@@ -282,7 +261,7 @@ void Pipeline::TrackerLoop() {
       s.hand->Process(*packet);
       {
         std::lock_guard<std::mutex> lock(s.mutex);
-        s.tracking = packet->frame_error.empty() ? packet->track.State() : "malformed frame";
+        s.hand_state = packet->HandState();
       }
       if (!s.tracked.Push(std::move(packet))) break;  // The fusion thread has stopped.
     }
@@ -309,7 +288,8 @@ void Pipeline::FusionLoop() {
     job->kind = kind;
     if (kind == ExportJob::Kind::kPreview) {
       job->frame = packet->frame;
-      job->model_view = ViewModel(object->volume(), s.intrinsics, packet->fusion.cam_from_object);
+      job->model_view =
+          ViewModelFromCamera(object->volume(), s.intrinsics, packet->fusion.cam_from_object);
       job->hand = packet->hand_mesh;
     } else {
       if (object) job->model = object->Snapshot();
@@ -349,6 +329,10 @@ void Pipeline::FusionLoop() {
       packet->latency_ms = MillisecondsSince(packet->captured_at);
       record->Add(*packet);
       s.coverage = packet->fusion.coverage;
+      {
+        std::lock_guard<std::mutex> lock(s.mutex);
+        s.object_state = packet->ObjectState();
+      }
       ++s.processed;
       s.processing_seconds = MillisecondsSince(s.start) / 1000.0;
       if (!packet->Registered()) continue;
@@ -369,9 +353,9 @@ void Pipeline::FusionLoop() {
         view.joint_parents = s.joint_parents;
         for (const auto& pair : packet->track.contact_pairs)
           view.contacts_mm.push_back(pair.current_mm);
-        view.model =
-            ViewModel(object->volume(), s.intrinsics, packet->fusion.cam_from_object).image;
-        view.tracking = packet->track.State();
+        view.viewpoint = {view_yaw_deg_.load(), view_pitch_deg_.load()};
+        view.model = ViewModelFitted(object->volume(), s.intrinsics, packet->fusion.cam_from_object,
+                                     view.viewpoint);
         live_view_.Put(std::move(view));
       }
     }
@@ -529,9 +513,15 @@ PipelineProgress Pipeline::Progress() const {
   progress.coverage = s.coverage.load();
   {
     std::lock_guard<std::mutex> lock(s.mutex);
-    progress.tracking = s.tracking;
+    progress.hand = s.hand_state;
+    progress.object = s.object_state;
   }
   return progress;
+}
+
+void Pipeline::SetModelViewpoint(const ModelViewpoint& viewpoint) {
+  view_yaw_deg_.store(viewpoint.yaw_deg);
+  view_pitch_deg_.store(viewpoint.pitch_deg);
 }
 
 CameraIntrinsics Pipeline::intrinsics() const {

@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/model_view.h"
 #include "app/preview.h"
 #include "app/run_record.h"
 #include "app/scan_record.h"
@@ -46,7 +47,8 @@ struct PipelineOutput {
   std::vector<std::string> extra_formats;
   /// How trajectory.txt is written.
   TrajectoryFormat trajectory_format = TrajectoryFormat::kCamFromObjectMm;
-  /// Publish a LiveView for a window (costs a raycast of the model every few frames).
+  /// Publish a LiveView for a window or a screenshot (costs a raycast of the model every few
+  /// frames).
   bool live_view = false;
 };
 
@@ -60,7 +62,8 @@ struct PipelineProgress {
   std::optional<std::int64_t> total;  ///< Frames in the recording, when known.
   double seconds = 0;                 ///< Since Start().
   double processing_seconds = 0;      ///< From Start() to the last frame through both stages.
-  std::string tracking;               ///< The tracker's last status ("tracked", …).
+  std::string hand = "waiting";       ///< The hand's state for a person: FramePacket::HandState().
+  std::string object = "waiting";  ///< The object's state for a person: FramePacket::ObjectState().
   double coverage = 0;                ///< Share of the directions around the object seen.
 
   /// Frames through both stages per second of processing.
@@ -69,8 +72,8 @@ struct PipelineProgress {
   }
 };
 
-/// What the live window shows: the latest frame with the hand and the model seen from the
-/// camera.
+/// What the live window shows: the latest frame with the hand and the model, fitted to the
+/// panel and turned as the user asked (SetModelViewpoint).
 struct LiveView {
   std::shared_ptr<const Frame> frame;
   /// Hand joints (camera frame, mm) and contact points of the frame.
@@ -78,10 +81,10 @@ struct LiveView {
   /// For each joint, the joint it is drawn connected to (-1: none).
   std::vector<int> joint_parents;
   std::vector<Eigen::Vector3d> contacts_mm;
-  /// The model raycast from the camera, shaded (same size as the frame; empty before the
-  /// model starts).
+  /// The model raycast from the viewpoint (ViewModelFitted), frame-sized; black before the
+  /// model starts.
   RgbImage model;
-  std::string tracking;
+  ModelViewpoint viewpoint;
 };
 
 /// How a pipeline ended.
@@ -137,6 +140,9 @@ class Pipeline {
   CameraIntrinsics intrinsics() const;
   /// The newest LiveView, if one was published since the last call.
   std::optional<LiveView> TakeLiveView() { return live_view_.Take(); }
+  /// Turns the LiveView's model from the camera's view (from the next view published on).
+  /// Safe from any thread.
+  void SetModelViewpoint(const ModelViewpoint& viewpoint);
 
  private:
   struct Shared;
@@ -162,6 +168,7 @@ class Pipeline {
   std::atomic<bool> reset_requested_{false};
   std::atomic<bool> abandon_requested_{false};
   LatestValue<LiveView> live_view_;
+  std::atomic<double> view_yaw_deg_{0}, view_pitch_deg_{0};  // SetModelViewpoint's.
   std::vector<std::thread> threads_;
   bool started_ = false;
   bool finished_ = false;

@@ -62,7 +62,22 @@ RgbImage PreviewRenderer::Draw(const Frame& frame, const ModelView& model,
       }
     }
   }
+  DrawPanelLabel(&image, 0, width, "camera");
+  DrawPanelLabel(&image, width, width, "model and fitted hand, as the camera sees them");
   return image;
+}
+
+void DrawPanelLabel(RgbImage* image, int x0, int width, const std::string& text) {
+  constexpr int kStrip = 24;
+  if (image->width <= 0 || x0 < 0 || width <= 0 || x0 + width > image->width ||
+      image->height < kStrip) {
+    return;
+  }
+  cv::Mat all(image->height, image->width, CV_8UC3, image->rgb.data());
+  cv::Mat strip = all(cv::Rect(x0, 0, width, kStrip));
+  strip *= 0.35;  // Darkened, the image still showing through.
+  cv::putText(strip, text, cv::Point(8, 17), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              cv::Scalar(240, 240, 240), 1, cv::LINE_AA);
 }
 
 void WritePng(const std::filesystem::path& path, const RgbImage& image) {

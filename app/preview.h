@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "core/camera_intrinsics.h"
@@ -46,6 +47,10 @@ class PreviewRenderer {
  private:
   std::unique_ptr<render::OffscreenRenderer> renderer_;
 };
+
+/// Labels the panel of `image` that starts at column `x0` and is `width` wide: `text` on a
+/// dark strip along its top (the live window's and the previews' panels).
+void DrawPanelLabel(RgbImage* image, int x0, int width, const std::string& text);
 
 /// Writes `image` as a PNG, atomically. Throws ihs::OutputError when it cannot.
 void WritePng(const std::filesystem::path& path, const RgbImage& image);

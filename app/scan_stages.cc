@@ -29,6 +29,16 @@ tracker::TrackerOptions TrackerOptionsFor(const ScannerOptions& options) {
   return tracker_options;
 }
 
+const char* FramePacket::HandState() const {
+  if (!frame_error.empty() || !track.HasPose()) return "lost";
+  return track.doubtful ? "doubtful" : "tracked";
+}
+
+const char* FramePacket::ObjectState() const {
+  if (Registered()) return "registered";
+  return frame_error.empty() && !track.HasPose() ? "paused" : "lost";
+}
+
 tracker::HandModel LoadHandTemplate(const ScanOptions& options) {
   tracker::HandModel model = tracker::LoadHandTemplate(options.hand_template, !options.left_hand);
   if (options.hand_scale > 0) model = model.Scaled(options.hand_scale);

@@ -58,6 +58,12 @@ struct FramePacket {
 
   /// Whether the frame was registered (started or fused).
   bool Registered() const { return fusion.status != fusion::FusionStatus::kSkipped; }
+  /// The hand's state for a person: "tracked", "doubtful" (a pose the data may not support),
+  /// "lost" (no usable pose: no hand, a fit that diverged, an empty or malformed frame).
+  const char* HandState() const;
+  /// The object's state for a person: "registered" (the frame was fused), "paused" (not fused:
+  /// no hand pose to go by), "lost" (not fused: the registration failed).
+  const char* ObjectState() const;
 };
 
 /// The hand template `options` names, at its given scale (procedural or a scanned model).

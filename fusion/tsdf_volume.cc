@@ -48,6 +48,18 @@ Eigen::Vector3f TsdfVolume::Centre(int i, int j, int k) const {
       .cast<float>();
 }
 
+Eigen::AlignedBox3f TsdfVolume::ObservedBox() const {
+  Eigen::AlignedBox3f box;  // Empty.
+  if (observed_hi_[0] < observed_lo_[0]) return box;
+  const float half = static_cast<float>(0.5 * options_.size_mm);
+  const float voxel = static_cast<float>(voxel_mm_);
+  for (int a = 0; a < 3; ++a) {
+    box.min()[a] = -half + observed_lo_[a] * voxel;
+    box.max()[a] = -half + (observed_hi_[a] + 1) * voxel;
+  }
+  return box;
+}
+
 std::int64_t TsdfVolume::ObservedVoxels() const {
   return std::count_if(voxels_.begin(), voxels_.end(), [](const Voxel& v) { return v.weight > 0; });
 }
@@ -219,13 +231,10 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
   const Eigen::Matrix3f to_cam = cam_from_volume.rotation().cast<float>();
   const float half = static_cast<float>(0.5 * options_.size_mm);
   const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
-  if (observed_hi_[0] < observed_lo_[0]) return;  // Nothing to see yet.
   // Rays are followed only through the box of observed voxels.
-  Eigen::Vector3f box_lo, box_hi;
-  for (int a = 0; a < 3; ++a) {
-    box_lo[a] = -half + observed_lo_[a] * voxel;
-    box_hi[a] = -half + (observed_hi_[a] + 1) * voxel;
-  }
+  const Eigen::AlignedBox3f observed = ObservedBox();
+  if (observed.isEmpty()) return;  // Nothing to see yet.
+  const Eigen::Vector3f box_lo = observed.min(), box_hi = observed.max();
   IHS_CHECK_ARG(near_depth_mm == nullptr || near_depth_mm->size() == pixels,
                 "near_depth_mm has " << near_depth_mm->size() << " entries, the image " << pixels);
   const bool whole = roi[2] <= roi[0] || roi[3] <= roi[1];

@@ -6,6 +6,7 @@
 // camera sees it (for ICP and previews); marching cubes gives its zero level set as a mesh.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -90,6 +91,9 @@ class TsdfVolume {
   const TsdfOptions& options() const { return options_; }
   /// Voxels observed at least once.
   std::int64_t ObservedVoxels() const;
+  /// The box (volume frame, mm) around the voxels observed so far: the model's surface with
+  /// its truncation band. Empty (`isEmpty()`) before the first integration.
+  Eigen::AlignedBox3f ObservedBox() const;
 
  private:
   struct Voxel {

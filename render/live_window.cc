@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <mutex>
+#include <utility>
 
 #include "core/errors.h"
 
@@ -68,7 +69,10 @@ struct GlFunctions {
 struct LiveWindow::State {
   GLFWwindow* window = nullptr;
   GlFunctions gl;
-  std::vector<char> keys;
+  WindowInput input;  // Since the last PollInput().
+  // Where the cursor was when last seen with the left button held (none: not dragging).
+  bool dragging = false;
+  double cursor_x = 0, cursor_y = 0;
   // The image shown last, drawn again for a screenshot.
   std::vector<std::uint8_t> shown;
   int shown_width = 0;
@@ -100,10 +104,23 @@ LiveWindow::LiveWindow(const std::string& title, int width, int height)
     if (action != GLFW_PRESS) return;
     auto* state = static_cast<State*>(glfwGetWindowUserPointer(window));
     if (key == GLFW_KEY_ESCAPE) {
-      state->keys.push_back('q');
+      state->input.keys.push_back('q');
     } else if (key >= GLFW_KEY_A && key <= GLFW_KEY_Z) {
-      state->keys.push_back(static_cast<char>('a' + (key - GLFW_KEY_A)));
+      state->input.keys.push_back(static_cast<char>('a' + (key - GLFW_KEY_A)));
     }
+  });
+  glfwSetMouseButtonCallback(state_->window, [](GLFWwindow* window, int button, int action, int) {
+    if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+    auto* state = static_cast<State*>(glfwGetWindowUserPointer(window));
+    state->dragging = action == GLFW_PRESS;
+    if (state->dragging) glfwGetCursorPos(window, &state->cursor_x, &state->cursor_y);
+  });
+  glfwSetCursorPosCallback(state_->window, [](GLFWwindow* window, double x, double y) {
+    auto* state = static_cast<State*>(glfwGetWindowUserPointer(window));
+    if (!state->dragging) return;
+    state->input.drag_x += x - state->cursor_x;
+    state->input.drag_y += y - state->cursor_y;
+    state->cursor_x = x, state->cursor_y = y;
   });
 }
 
@@ -147,11 +164,11 @@ void LiveWindow::Draw() {
   if (!rgb.empty()) gl.DrawPixels(width, height, GL_RGB, GL_UNSIGNED_BYTE, rgb.data());
 }
 
-std::vector<char> LiveWindow::PollKeys() {
+WindowInput LiveWindow::PollInput() {
   glfwPollEvents();
-  std::vector<char> keys;
-  keys.swap(state_->keys);
-  return keys;
+  WindowInput input;
+  std::swap(input, state_->input);
+  return input;
 }
 
 std::vector<std::uint8_t> LiveWindow::Screenshot(int* width, int* height) {

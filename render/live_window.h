@@ -10,6 +10,15 @@
 
 namespace ihs::render {
 
+/// What the user did in the window since the last poll.
+struct WindowInput {
+  /// Keys pressed, as lower-case ASCII characters ('s', 'r', 'q', …; Escape is reported as 'q').
+  std::vector<char> keys;
+  /// How far the mouse moved with its left button held (a drag), window pixels; y down.
+  double drag_x = 0;
+  double drag_y = 0;
+};
+
 /// A window that displays RGB8 images.
 class LiveWindow {
  public:
@@ -22,9 +31,9 @@ class LiveWindow {
 
   /// Draws `rgb` (width·height·3 bytes, row-major from the top-left pixel), scaled to the window.
   void Show(const std::vector<std::uint8_t>& rgb, int width, int height);
-  /// Processes window events; returns the keys pressed since the last call as lower-case ASCII
-  /// characters ('s', 'r', 'q', …; Escape is reported as 'q').
-  std::vector<char> PollKeys();
+  /// Processes window events; returns the keys pressed and the mouse dragged since the last
+  /// call.
+  WindowInput PollInput();
   /// What the window shows now, read back from its front buffer: RGB8, row-major from the
   /// top-left pixel, `*width`×`*height` pixels.
   std::vector<std::uint8_t> Screenshot(int* width, int* height);

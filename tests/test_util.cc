@@ -1,14 +1,17 @@
 #include "tests/test_util.h"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+#include <thread>
 
 namespace ihs::test {
 
@@ -79,6 +82,40 @@ void WriteBytes(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   if (!out) throw std::runtime_error("cannot write test file " + path.string());
+}
+
+VirtualDisplay::VirtualDisplay(int width, int height) {
+  const std::string screen = std::to_string(width) + "x" + std::to_string(height) + "x24";
+  for (int display = 70 + getpid() % 100; display < 300 && pid_ <= 0; ++display) {
+    const std::string socket = "/tmp/.X11-unix/X" + std::to_string(display);
+    if (std::filesystem::exists(socket)) continue;
+    name_ = ":" + std::to_string(display);
+    pid_ = fork();
+    if (pid_ == 0) {
+      execlp("Xvfb", "Xvfb", name_.c_str(), "-screen", "0", screen.c_str(), "-nolisten", "tcp",
+             static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    // Xvfb makes its socket when it is ready to serve.
+    for (int i = 0; i < 100 && !std::filesystem::exists(socket); ++i) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {  // Xvfb is missing or failed.
+        pid_ = -1;
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    if (!std::filesystem::exists(socket)) Stop();
+  }
+}
+
+VirtualDisplay::~VirtualDisplay() { Stop(); }
+
+void VirtualDisplay::Stop() {
+  if (pid_ <= 0) return;
+  kill(pid_, SIGTERM);
+  waitpid(pid_, nullptr, 0);
+  pid_ = -1;
 }
 
 }  // namespace ihs::test

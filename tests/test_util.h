@@ -53,6 +53,24 @@ CommandResult RunCommand(const std::string& command);
 /// Reads a whole file; empty if it cannot be read.
 std::string ReadFileString(const std::filesystem::path& path);
 
+/// An Xvfb server on a free display of `width`×`height` pixels for the object's lifetime (for
+/// tests of windows). Not ok() when Xvfb is missing or fails to start.
+class VirtualDisplay {
+ public:
+  VirtualDisplay(int width, int height);
+  ~VirtualDisplay();
+  VirtualDisplay(const VirtualDisplay&) = delete;
+  VirtualDisplay& operator=(const VirtualDisplay&) = delete;
+  bool ok() const { return pid_ > 0; }
+  /// The display's name for $DISPLAY (":71").
+  const std::string& name() const { return name_; }
+
+ private:
+  void Stop();
+  std::string name_;
+  int pid_ = -1;
+};
+
 /// Writes `bytes` to `path` (plain, non-atomic), for preparing test inputs.
 void WriteBytes(const std::filesystem::path& path, const std::string& bytes);
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "core/mesh_io.h"
@@ -257,6 +258,46 @@ TEST_F(InhandscanSignalTest, ReplayWritesEveryOutputAndTheFormatsAskedFor) {
   }
   // A preview every 30 fused frames.
   EXPECT_FALSE(fs::is_empty(out / "preview"));
+}
+
+// The pixels of `image`'s bottom `rows` rows coloured as a state that is well (green).
+int GreenPixelsAtTheBottom(const cv::Mat& bgr, int rows) {
+  int green = 0;
+  for (int v = std::max(0, bgr.rows - rows); v < bgr.rows; ++v) {
+    for (int u = 0; u < bgr.cols; ++u) {
+      const cv::Vec3b p = bgr.at<cv::Vec3b>(v, u);
+      green += p[1] > 180 && p[0] < 150 && p[2] < 150;
+    }
+  }
+  return green;
+}
+
+// --screenshot saves the screen as the window shows it: composed off-screen without a window,
+// read back from the window with one (on a virtual display). Both show the states in colour
+// (here "tracked" and "registered", green) in the status bar.
+TEST_F(InhandscanSignalTest, ScreenshotsWithAndWithoutAWindow) {
+  test::TempDir dir;
+  const std::string replay = "replay " + (*dir_ / "sequence.oni").string() +
+                             " --set pipeline.max_frames=31 --quiet --screenshot ";
+  const auto headless =
+      RunApp(replay + (dir / "screen.png").string() + " --out " + (dir / "a").string());
+  ASSERT_EQ(headless.exit_code, 0) << headless.err;
+  const cv::Mat screen = cv::imread((dir / "screen.png").string());
+  ASSERT_FALSE(screen.empty()) << headless.err;
+  EXPECT_EQ(screen.cols, 2 * 640);  // Two panels of the camera's size and a status bar.
+  EXPECT_GT(screen.rows, 480);
+  EXPECT_GT(GreenPixelsAtTheBottom(screen, screen.rows - 480), 20);
+
+  test::VirtualDisplay display(1280, 1024);
+  if (!display.ok()) GTEST_SKIP() << "no Xvfb (Debian package xvfb) to open a window on";
+  const auto windowed = test::RunCommand("DISPLAY=" + display.name() + " " + IHS_APP + " " +
+                                         replay + (dir / "window.png").string() + " --window" +
+                                         " --out " + (dir / "b").string());
+  ASSERT_EQ(windowed.exit_code, 0) << windowed.err;
+  EXPECT_EQ(windowed.err.find("scanning without a window"), std::string::npos) << windowed.err;
+  const cv::Mat window = cv::imread((dir / "window.png").string());
+  ASSERT_FALSE(window.empty()) << windowed.err;
+  EXPECT_GT(GreenPixelsAtTheBottom(window, window.rows / 10), 20);
 }
 
 // The output folder records the run: the options in effect (flags and --set) as options.conf,

@@ -4,65 +4,19 @@
 #include "render/live_window.h"
 
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
-#include <chrono>
 #include <cstdlib>
-#include <filesystem>
 #include <string>
-#include <thread>
 
 #include "core/errors.h"
+#include "tests/test_util.h"
 
 namespace ihs::render {
 namespace {
 
-// An Xvfb server on a free display for the test's lifetime.
-class VirtualDisplay {
- public:
-  VirtualDisplay() {
-    for (int display = 70 + getpid() % 100; display < 300 && pid_ <= 0; ++display) {
-      const std::string socket = "/tmp/.X11-unix/X" + std::to_string(display);
-      if (std::filesystem::exists(socket)) continue;
-      name_ = std::to_string(display);
-      name_.insert(name_.begin(), ':');
-      pid_ = fork();
-      if (pid_ == 0) {
-        execlp("Xvfb", "Xvfb", name_.c_str(), "-screen", "0", "320x240x24", "-nolisten", "tcp",
-               static_cast<char*>(nullptr));
-        _exit(127);
-      }
-      for (int i = 0; i < 100 && !std::filesystem::exists(socket); ++i) {
-        int status = 0;
-        if (waitpid(pid_, &status, WNOHANG) == pid_) {  // Xvfb is missing or failed.
-          pid_ = -1;
-          return;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      }
-      if (!std::filesystem::exists(socket)) Stop();
-    }
-  }
-  ~VirtualDisplay() { Stop(); }
-  bool ok() const { return pid_ > 0; }
-  const std::string& name() const { return name_; }
-
- private:
-  void Stop() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGTERM);
-    waitpid(pid_, nullptr, 0);
-    pid_ = -1;
-  }
-  std::string name_;
-  pid_t pid_ = -1;
-};
-
 TEST(LiveWindowTest, ShowsAnImageAsGiven) {
-  VirtualDisplay display;
+  test::VirtualDisplay display(320, 240);
   if (!display.ok()) GTEST_SKIP() << "no Xvfb (Debian package xvfb) to open a window on";
   setenv("DISPLAY", display.name().c_str(), 1);
   LiveWindow window("test", 64, 48);
@@ -81,7 +35,10 @@ TEST(LiveWindowTest, ShowsAnImageAsGiven) {
     }
   }
   window.Show(rgb, 64, 48);
-  EXPECT_TRUE(window.PollKeys().empty());
+  const WindowInput input = window.PollInput();
+  EXPECT_TRUE(input.keys.empty());
+  EXPECT_EQ(input.drag_x, 0.0);
+  EXPECT_EQ(input.drag_y, 0.0);
   EXPECT_FALSE(window.ShouldClose());
   int width = 0, height = 0;
   const std::vector<std::uint8_t> shot = window.Screenshot(&width, &height);
