@@ -289,6 +289,28 @@ fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const Triangl
   return fusion::CompareSurfaces(placed, ReadMesh(gt_dir / "object.ply"));
 }
 
+// The paper's dimensions of `object` measured on `mesh`, printed by `print` as a table, as JSON
+// "dimensions" + `suffix` and "dimension_error_mm_mean" + `suffix`.
+template <typename Print>
+nlohmann::json DimensionReport(const std::string& object, const TriangleMesh& mesh,
+                               const std::string& suffix, Print& print) {
+  nlohmann::json report = nlohmann::json::object();
+  const std::vector<DimensionRow> rows = PaperDimensions(object, mesh);
+  print("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
+  double sum = 0;
+  nlohmann::json& table = report["dimensions" + suffix] = nlohmann::json::array();
+  for (const DimensionRow& row : rows) {
+    print("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm, row.captured_mm,
+          row.Error());
+    table.push_back(
+        {{"measure", row.measure}, {"truth_mm", row.truth_mm}, {"scan_mm", row.captured_mm}});
+    sum += std::abs(row.Error());
+  }
+  report["dimension_error_mm_mean" + suffix] = sum / rows.size();
+  print("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
+  return report;
+}
+
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const fs::path& gt_dir,
                           const std::vector<StampedPose>& trajectory,
@@ -299,18 +321,12 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
   };
   nlohmann::json report = nlohmann::json::object();
   if (!object.empty()) {
-    const std::vector<DimensionRow> rows = PaperDimensions(object, seen);
-    print("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
-    double sum = 0;
-    for (const DimensionRow& row : rows) {
-      print("%-16s %10.2f %10.2f %+10.2f\n", row.measure.c_str(), row.truth_mm, row.captured_mm,
-            row.Error());
-      report["dimensions"].push_back(
-          {{"measure", row.measure}, {"truth_mm", row.truth_mm}, {"scan_mm", row.captured_mm}});
-      sum += std::abs(row.Error());
+    report.update(DimensionReport(object, seen, "", print));
+    // What the user takes away: the same measures on the closed mesh, where it is another.
+    if (&watertight != &seen && !watertight.faces.empty()) {
+      print("on the watertight mesh (mesh.ply):\n");
+      report.update(DimensionReport(object, watertight, "_watertight", print));
     }
-    report["dimension_error_mm_mean"] = sum / rows.size();
-    print("mean absolute error: %.2f mm over %zu measures\n", sum / rows.size(), rows.size());
     if (watertight.IsWatertight()) {
       const double truth = TrueVolume(object), volume = watertight.Volume();
       print("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%", truth, volume,

@@ -109,7 +109,9 @@ ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
 /// Prints a scan's measures as a table for people on `out` (nullptr: prints nothing) and returns
 /// them as JSON: with
 /// `object` (a paper object or lathe:FILE) the paper's dimensions measured on `seen` ("dimensions",
-/// "dimension_error_mm_mean") and, when `watertight` is, its volume against the truth
+/// "dimension_error_mm_mean") and, when `watertight` is another mesh, on it too (what the user
+/// gets: "dimensions_watertight", "dimension_error_mm_mean_watertight"), and when `watertight`
+/// is watertight, its volume against the truth
 /// ("volume_mm3", "volume_error"); with `gt_dir` the pairwise registration error at the
 /// fingertips, the trajectory's drift and `seen` against the true surface ("pairwise_error_mm",
 /// "trajectory_error_mm", "chamfer_mm", "completeness"), `seen` placed by `trajectory`. With

@@ -69,6 +69,39 @@ TEST(MeasureToolTest, AWatertightMeshWithItsSeenSurfaceSaysHowMuchOfItWasNeverSe
                    .contains("volume_unseen_share"));
 }
 
+// What the user takes away is measured too: the paper's dimensions on the watertight mesh
+// (here 5 % too large) beside those on the seen surface (true).
+TEST(MeasureToolTest, TheDeliveredMeshIsMeasuredBesideTheSeenSurface) {
+  test::TempDir dir;
+  const TriangleMesh pin = synth::MakeLatheMesh(
+      synth::ResampleProfile(synth::PaperObjectProfile("bowling-pin"), 0.5), 256);
+  TriangleMesh swollen = pin;
+  for (auto& v : swollen.vertices) v *= 1.05f;
+  WriteMesh(dir / "mesh.ply", swollen);
+  WriteMesh(dir / "mesh_tsdf.ply", pin);
+  const auto run =
+      RunTool((dir / "mesh.ply").string() + " --seen " + (dir / "mesh_tsdf.ply").string() +
+              " --object bowling-pin --json " + (dir / "m.json").string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("on the watertight mesh (mesh.ply)"), std::string::npos) << run.out;
+  const auto json = nlohmann::json::parse(test::ReadFileString(dir / "m.json"));
+  ASSERT_EQ(json["dimensions"].size(), 3u);
+  ASSERT_EQ(json["dimensions_watertight"].size(), 3u);
+  for (int d = 0; d < 3; ++d) {
+    const double truth = json["dimensions"][d]["truth_mm"].get<double>();
+    EXPECT_NEAR(json["dimensions"][d]["scan_mm"].get<double>(), truth, 0.5);
+    EXPECT_NEAR(json["dimensions_watertight"][d]["scan_mm"].get<double>(), 1.05 * truth, 0.5);
+  }
+  EXPECT_GT(json["dimension_error_mm_mean_watertight"].get<double>(),
+            json["dimension_error_mm_mean"].get<double>() + 2);
+  // One mesh alone: measured once.
+  const auto alone = RunTool((dir / "mesh.ply").string() + " --object bowling-pin --json " +
+                             (dir / "alone.json").string());
+  ASSERT_EQ(alone.exit_code, 0) << alone.err;
+  EXPECT_FALSE(nlohmann::json::parse(test::ReadFileString(dir / "alone.json"))
+                   .contains("dimensions_watertight"));
+}
+
 TEST(MeasureToolTest, BadInputGetsOneLineErrors) {
   test::TempDir dir;
   const auto missing = RunTool((dir / "none.ply").string());
