@@ -339,7 +339,6 @@ int main(int argc, char** argv) {
   app.footer(ihs::ExitCodesHelp());
   app.set_version_flag("--version", std::string("inhandscan ") + IHS_VERSION);
   app.require_subcommand(1);
-  app.fallthrough();  // Global options may also follow the subcommand.
   std::string log_level = "info";
   bool quiet = false;
   std::string config_file;
@@ -378,6 +377,7 @@ int main(int argc, char** argv) {
   CLI::App* devices = app.add_subcommand("devices", "list cameras on USB and what OpenNI2 sees");
   CLI::App* config =
       app.add_subcommand("config", "print every option with its default and meaning");
+  ihs::ShareOptionsWithSubcommands(app);  // Global options may also follow the subcommand.
 
   if (const auto meant = MistypedSubcommand(app, argc, argv)) {
     std::fprintf(stderr, "inhandscan: error: unknown command '%s' (did you mean '%s'?)\n", argv[1],

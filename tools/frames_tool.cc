@@ -181,6 +181,7 @@ int main(int argc, char** argv) {
   convert->add_option("input", input, ".oni file or TUM folder")->required();
   convert->add_option("output", output, ".oni file or TUM folder to write")->required();
   add_input_options(convert);
+  ihs::ShareOptionsWithSubcommands(app);
 
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-frames", [&] {

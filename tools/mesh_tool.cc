@@ -71,6 +71,7 @@ int main(int argc, char** argv) {
   convert->add_option("input", input, "mesh file to read")->required();
   convert->add_option("output", output, "mesh file to write (.ply, .obj, .stl)")->required();
   convert->add_flag("--ascii", ascii, "write PLY as ASCII instead of binary");
+  ihs::ShareOptionsWithSubcommands(app);
 
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   return ihs::RunReportingErrors("inhandscan-mesh", [&] {

@@ -43,6 +43,31 @@ TEST(InhandscanTest, HelpListsTheSubcommandsAndExitCodes) {
   EXPECT_NE(version.out.find(IHS_VERSION), std::string::npos);
 }
 
+// Each subcommand's help lists the global options, which may stand before or after it: --set
+// on both sides adds up, and a bad --log-level on either side is refused.
+TEST(InhandscanTest, SubcommandHelpListsTheGlobalOptionsThatMayFollowIt) {
+  for (const char* command : {"live", "replay", "record", "devices", "config"}) {
+    const auto help = RunApp(std::string(command) + " --help");
+    EXPECT_EQ(help.exit_code, 0) << command << ": " << help.err;
+    const size_t global = help.out.find("Global options");
+    ASSERT_NE(global, std::string::npos) << command << ": " << help.out;
+    for (const char* option : {"--log-level", "--quiet", "--config", "--set", "--version"}) {
+      EXPECT_NE(help.out.find(option, global), std::string::npos) << command << ": " << option;
+    }
+    EXPECT_NE(help.out.find("Exit codes:", global), std::string::npos) << help.out;
+  }
+  EXPECT_EQ(RunApp("--help").out.find("Global options"), std::string::npos);
+  const auto both = RunApp("--set mesh.poisson_depth=7 config --set fusion.tsdf.resolution=128");
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  EXPECT_NE(both.out.find("mesh.poisson_depth = 7\n"), std::string::npos);
+  EXPECT_NE(both.out.find("fusion.tsdf.resolution = 128\n"), std::string::npos);
+  for (const char* arguments : {"--log-level loud config", "config --log-level loud"}) {
+    const auto run = RunApp(arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments;
+    EXPECT_NE(run.err.find("--log-level"), std::string::npos) << arguments << ": " << run.err;
+  }
+}
+
 TEST(InhandscanTest, ConfigPrintsEveryOptionAsAFileItReadsBack) {
   test::TempDir dir;
   const auto config = RunApp("config --set fusion.pairwise.contact_weight=5");

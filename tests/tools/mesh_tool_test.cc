@@ -110,5 +110,25 @@ TEST(MeshToolTest, VersionAndHelpExitZero) {
   EXPECT_NE(help.output.find("Exit codes:"), std::string::npos) << help.output;
 }
 
+// The global options may follow a subcommand, and its help lists them.
+TEST(MeshToolTest, SubcommandsTakeAndListTheGlobalOptions) {
+  const ToolRun help = RunTool("convert --help");
+  EXPECT_EQ(help.exit_code, 0);
+  const size_t global = help.output.find("Global options");
+  ASSERT_NE(global, std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("--log-level", global), std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("-q,--quiet", global), std::string::npos) << help.output;
+  test::TempDir dir;
+  WriteMesh(dir / "cube.ply", test::MakeCube(20));
+  const std::string convert =
+      "convert " + (dir / "cube.ply").string() + " " + (dir / "cube.stl").string();
+  const ToolRun loud = RunTool(convert);
+  ASSERT_EQ(loud.exit_code, 0) << loud.output;
+  EXPECT_NE(loud.output.find("[info] wrote"), std::string::npos) << loud.output;
+  const ToolRun quiet = RunTool(convert + " --quiet");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
+}
+
 }  // namespace
 }  // namespace ihs
