@@ -197,22 +197,17 @@ class ProgressReporter {
                   done.c_str(), fps, static_cast<long long>(progress.registered),
                   static_cast<long long>(progress.dropped), 100 * progress.coverage, eta.c_str());
     if (terminal_) {
-      std::fprintf(stderr, "\r%-78s", line);
-      shown_ = true;
+      ihs::ProgressLine::OnStderr().Show(line);  // Log lines meanwhile go above it.
     } else if (progress.seconds - last_log_s_ >= 10.0) {
       last_log_s_ = progress.seconds;
       spdlog::info("{}", line);
     }
   }
 
-  void Done() {
-    if (shown_) std::fprintf(stderr, "\n");
-    shown_ = false;
-  }
+  void Done() { ihs::ProgressLine::OnStderr().End(); }
 
  private:
   const bool terminal_;
-  bool shown_ = false;
   double last_log_s_ = 0;
 };
 
