@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the main job on the built-in sample.
+# Installs what is missing, builds, and runs the main job on the built-in sample. A user's build:
+# neither the tests nor the benchmark's Open3D peer (tools/test.sh installs and builds those).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-"$root/tools/build.sh"
+IHS_TESTS=OFF "$root/tools/build.sh"
 build_dir="${IHS_BUILD_DIR:-build}"
 [[ "$build_dir" = /* ]] || build_dir="$root/$build_dir"
 

@@ -16,11 +16,11 @@ targets=("$@")
   echo "fuzz: SECONDS must be a positive whole number, got '$seconds'" >&2
   exit 2
 }
+"$root/tools/install-deps.sh" --dev  # clang and its libFuzzer among them.
 command -v clang++ >/dev/null || {
   echo "fuzz: needs clang (apt-get install clang)" >&2
   exit 2
 }
-"$root/tools/install-deps.sh"
 build="${IHS_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DIHS_FUZZ=ON >/dev/null
