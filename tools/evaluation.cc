@@ -311,6 +311,23 @@ nlohmann::json DimensionReport(const std::string& object, const TriangleMesh& me
   return report;
 }
 
+void ReportVolume(double truth_mm3, const TriangleMesh& watertight,
+                  std::optional<double> unseen_share, std::FILE* out, nlohmann::json* report) {
+  const double volume = watertight.Volume();
+  if (out) {
+    std::fprintf(out, "volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%", truth_mm3, volume,
+                 100 * (volume / truth_mm3 - 1));
+  }
+  (*report)["volume_mm3"] = {{"truth", truth_mm3}, {"scan", volume}};
+  (*report)["volume_error"] = volume / truth_mm3 - 1;
+  if (unseen_share) {
+    // What no frame saw, Poisson closed: the volume is a guess over that part.
+    if (out) std::fprintf(out, " (%.0f %% of its surface never seen)", 100 * *unseen_share);
+    (*report)["volume_unseen_share"] = *unseen_share;
+  }
+  if (out) std::fprintf(out, "\n");
+}
+
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const fs::path& gt_dir,
                           const std::vector<StampedPose>& trajectory,
@@ -328,17 +345,7 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
       report.update(DimensionReport(object, watertight, "_watertight", print));
     }
     if (watertight.IsWatertight()) {
-      const double truth = TrueVolume(object), volume = watertight.Volume();
-      print("volume: truth %.0f mm³, scan %.0f mm³, %+.2f %%", truth, volume,
-            100 * (volume / truth - 1));
-      report["volume_mm3"] = {{"truth", truth}, {"scan", volume}};
-      report["volume_error"] = volume / truth - 1;
-      if (unseen_share) {
-        // What no frame saw, Poisson closed: the volume is a guess over that part.
-        print(" (%.0f %% of its surface never seen)", 100 * *unseen_share);
-        report["volume_unseen_share"] = *unseen_share;
-      }
-      print("\n");
+      ReportVolume(TrueVolume(object), watertight, unseen_share, out, &report);
     }
   }
   if (!gt_dir.empty()) {
@@ -371,6 +378,7 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
         100 * surface.completeness, surface.within_mm);
     report["chamfer_mm"] = surface.chamfer_mm;
     report["completeness"] = surface.completeness;
+    report["completeness_within_mm"] = surface.within_mm;
   }
   return report;
 }

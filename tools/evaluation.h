@@ -113,14 +113,21 @@ ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
 /// gets: "dimensions_watertight", "dimension_error_mm_mean_watertight"), and when `watertight`
 /// is watertight, its volume against the truth
 /// ("volume_mm3", "volume_error"); with `gt_dir` the pairwise registration error at the
-/// fingertips, the trajectory's drift and `seen` against the true surface ("pairwise_error_mm",
-/// "trajectory_error_mm", "chamfer_mm", "completeness"), `seen` placed by `trajectory`. With
-/// `unseen_share` (the share of `watertight`'s surface no frame saw: fusion::UnseenShare, which
-/// every export computes) the volume comes with it ("volume_unseen_share").
+/// fingertips, the trajectory's drift, how far the object turned ("rotation_error_deg",
+/// "turned_deg") and `seen` against the true surface ("pairwise_error_mm", "trajectory_error_mm",
+/// "chamfer_mm", "completeness" within "completeness_within_mm"), `seen` placed by `trajectory`.
+/// With `unseen_share` (the share of `watertight`'s surface no frame saw: fusion::UnseenShare,
+/// which every export computes) the volume comes with it ("volume_unseen_share").
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const std::filesystem::path& gt_dir,
                           const std::vector<StampedPose>& trajectory,
                           std::optional<double> unseen_share, std::FILE* out = stdout);
+
+/// The volume of `watertight` against `truth_mm3` (ReportScan's line; e.g. gt/object.ply's volume
+/// for an object that is no body of revolution), printed to `out` unless it is null and added to
+/// `report`: "volume_mm3", "volume_error" and, with `unseen_share`, "volume_unseen_share".
+void ReportVolume(double truth_mm3, const TriangleMesh& watertight,
+                  std::optional<double> unseen_share, std::FILE* out, nlohmann::json* report);
 
 /// The pose of `trajectory` stamped `time_s` (within half a millisecond), or nullptr.
 const StampedPose* FindPose(const std::vector<StampedPose>& trajectory, double time_s);

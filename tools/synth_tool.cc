@@ -85,7 +85,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-oni", no_oni, "do not write sequence.oni");
   app.add_flag("--no-tum", no_tum, "do not write the tum/ folder");
-  app.add_option("--preset", preset, "demo: 150 frames, procedural hand, sphere")
+  app.add_option("--preset", preset,
+                 "demo: the textured box turned a full turn in 180 frames, procedural hand")
       ->check(CLI::IsMember({"demo"}));
   app.add_option("--out", out, "output folder")->required();
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off");
@@ -94,10 +95,13 @@ int main(int argc, char** argv) {
   return ihs::RunReportingErrors("inhandscan-synth", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel(log_level), quiet);
     if (preset == "demo") {
-      if (app.count("--object") == 0) options.object = "sphere";
+      // A box, whose turn shows in its mesh (a sphere's lost spin would not), a full turn in as
+      // many frames as tools/demo.sh scans in well under a minute.
+      if (app.count("--object") == 0) options.object = "box";
       if (app.count("--motion") == 0) options.motion = "scripted";
       if (app.count("--hand") == 0) options.hand = "procedural";
-      if (app.count("--scripted-frames") == 0) options.scripted.frames = 150;
+      if (app.count("--scripted-frames") == 0) options.scripted.frames = 180;
+      if (app.count("--turns") == 0) options.scripted.turns = 1.0;
     }
     if (!frames.empty()) ParseFrameRange(frames, &options.first_frame, &options.last_frame);
     if (no_noise) options.sensor = ihs::synth::SensorModelOptions::Ideal();

@@ -1,13 +1,19 @@
-// inhandscan-measure on a true object's mesh: the paper's measures, JSON out, bad input.
+// inhandscan-measure on a true object's mesh: the paper's measures, JSON out, the summary of a
+// scan against a generator's ground truth, bad input.
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "core/mesh_io.h"
+#include "core/trajectory_io.h"
+#include "tests/mesh_fixtures.h"
 #include "tests/test_util.h"
 #include "tools/synth/objects.h"
+#include "tools/synth/sequence.h"
 
 namespace ihs {
 namespace {
@@ -102,6 +108,74 @@ TEST(MeasureToolTest, TheDeliveredMeshIsMeasuredBesideTheSeenSurface) {
                    .contains("dimensions_watertight"));
 }
 
+// The first grasp of a scripted box turn (ground truth only), the demo sample's object.
+class MeasureToolTurnTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir();
+    synth::SequenceOptions options;
+    options.object = "box";
+    options.scripted.frames = 60;
+    options.last_frame = 9;  // The first grasp: the box turns about 90°.
+    options.write_oni = false;
+    options.write_tum = false;
+    synth::GenerateSequence(options, dir_->path() / "seq");
+    // The true box (60 × 45 × 90 mm standing on z = 0) as one closed mesh of 8 vertices.
+    TriangleMesh box = test::MakeCube(1.0f);
+    for (auto& v : box.vertices)
+      v = v.cwiseProduct(Eigen::Vector3f(60, 45, 90)) + Eigen::Vector3f(0, 0, 45);
+    WriteMesh(dir_->path() / "box.ply", box);
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::filesystem::path Dir() { return dir_->path(); }
+  static std::filesystem::path Gt() { return dir_->path() / "seq" / "gt"; }
+  static inline test::TempDir* dir_ = nullptr;
+};
+
+// The numbers of the summary's first line: followed and true turn, rotation error at the end.
+struct TurnLine {
+  double followed = -1, truth = -1, end_error = -1;
+};
+TurnLine ParseTurnLine(const std::string& out) {
+  TurnLine line;
+  std::sscanf(out.c_str(),
+              "the scan followed %lf° of the true %lf° turn (rotation error at the end %lf°",
+              &line.followed, &line.truth, &line.end_error);
+  return line;
+}
+
+TEST_F(MeasureToolTurnTest, TheSummarySaysHowMuchOfTheTrueTurnTheScanFollowed) {
+  const std::string common =
+      (Dir() / "box.ply").string() + " --gt " + Gt().string() + " --summary --trajectory ";
+  // A scan that followed the truth exactly: the whole turn, no error, the box's own volume.
+  const auto exact = RunTool(common + (Gt() / "trajectory.txt").string() + " --json " +
+                             (Dir() / "exact.json").string());
+  ASSERT_EQ(exact.exit_code, 0) << exact.err;
+  EXPECT_EQ(std::count(exact.out.begin(), exact.out.end(), '\n'), 2) << exact.out;
+  const TurnLine all = ParseTurnLine(exact.out);
+  EXPECT_GT(all.truth, 45.0) << exact.out;  // The scripted grasp turns the box.
+  EXPECT_EQ(all.followed, all.truth) << exact.out;
+  EXPECT_EQ(all.end_error, 0.0) << exact.out;
+  EXPECT_NE(exact.out.find("volume +0.0 %"), std::string::npos) << exact.out;
+  const auto json = nlohmann::json::parse(test::ReadFileString(Dir() / "exact.json"));
+  EXPECT_NEAR(json["volume_mm3"]["truth"].get<double>(), 60.0 * 45 * 90, 1.0);
+  EXPECT_LT(json["chamfer_mm"].get<double>(), 0.2);
+
+  // A scan that held the box still in its first pose: none of the turn followed, and at the end
+  // it is off by the truth's whole rotation since the first frame.
+  std::vector<StampedPose> still = ReadTumTrajectory(Gt() / "trajectory.txt");
+  const Eigen::AngleAxisd since_first(still.front().transform.rotation().transpose() *
+                                      still.back().transform.rotation());
+  for (auto& pose : still) pose.transform = still.front().transform;
+  WriteTumTrajectory(Dir() / "still.txt", still);
+  const auto held = RunTool(common + (Dir() / "still.txt").string());
+  ASSERT_EQ(held.exit_code, 0) << held.err;
+  const TurnLine none = ParseTurnLine(held.out);
+  EXPECT_EQ(none.truth, all.truth) << held.out;
+  EXPECT_NEAR(none.followed, 0.0, 0.5) << held.out;
+  EXPECT_NEAR(none.end_error, since_first.angle() * 180 / M_PI, 0.05) << held.out;
+}
+
 TEST(MeasureToolTest, BadInputGetsOneLineErrors) {
   test::TempDir dir;
   const auto missing = RunTool((dir / "none.ply").string());
@@ -115,6 +189,9 @@ TEST(MeasureToolTest, BadInputGetsOneLineErrors) {
       RunTool((dir / "ball.ply").string() + " --seen " + (dir / "none.ply").string());
   EXPECT_EQ(no_seen.exit_code, 2) << no_seen.err;
   EXPECT_EQ(std::count(no_seen.err.begin(), no_seen.err.end(), '\n'), 1) << no_seen.err;
+  const auto summary_without_truth = RunTool((dir / "ball.ply").string() + " --summary");
+  EXPECT_EQ(summary_without_truth.exit_code, 2) << summary_without_truth.err;
+  EXPECT_NE(summary_without_truth.err.find("--gt"), std::string::npos);
 }
 
 }  // namespace

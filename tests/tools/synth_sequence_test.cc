@@ -237,6 +237,14 @@ TEST(SynthToolTest, WritesTheLayoutAndRejectsBadOptionsInOneLine) {
     EXPECT_TRUE(fs::exists(dir / "demo" / file)) << file;
   }
   EXPECT_EQ(ReadTumTrajectory(dir / "demo" / "gt" / "trajectory.txt").size(), 5u);
+  // The demo's sample: the textured box, whose turn its mesh shows, a full turn in 180 frames.
+  const auto manifest =
+      nlohmann::json::parse(test::ReadFileString(dir / "demo" / "gt" / "manifest.json"));
+  EXPECT_EQ(manifest["object"]["name"], "box");
+  EXPECT_EQ(manifest["object"]["textured"], true);
+  EXPECT_EQ(manifest["scripted"]["frames"], 180);
+  EXPECT_EQ(manifest["scripted"]["turns"], 1.0);
+  EXPECT_EQ(manifest["hand"], "procedural");
 
   const auto bad_object = RunTool("--object teapot --out " + (dir / "x").string());
   EXPECT_EQ(bad_object.exit_code, 2);
