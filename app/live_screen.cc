@@ -108,6 +108,11 @@ std::string StatusLine(const PipelineProgress& progress) {
   return "hand: " + progress.hand + " | object: " + progress.object + " | " + CountsText(progress);
 }
 
+void LiveScreenSize(const CameraIntrinsics& intrinsics, int* width, int* height) {
+  *width = 2 * intrinsics.width;
+  *height = intrinsics.height + kStatusHeight;
+}
+
 RgbImage ComposeLiveScreen(const LiveView& view, const CameraIntrinsics& intrinsics,
                            const PipelineProgress& progress) {
   const int width = view.frame ? view.frame->width : intrinsics.width;

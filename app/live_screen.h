@@ -20,6 +20,9 @@ namespace ihs::app {
 /// The status bar's first line: hand and object state, share seen, frame rate and counts.
 std::string StatusLine(const PipelineProgress& progress);
 
+/// The size of ComposeLiveScreen's image for a camera with `intrinsics`: the window's size.
+void LiveScreenSize(const CameraIntrinsics& intrinsics, int* width, int* height);
+
 /// Composes the live window's image from `view` and `progress` (two frames wide, with a status
 /// bar below).
 RgbImage ComposeLiveScreen(const LiveView& view, const CameraIntrinsics& intrinsics,

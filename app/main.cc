@@ -311,7 +311,9 @@ int Scan(std::unique_ptr<ihs::sensor::FrameSource> source, ihs::app::ScannerOpti
   std::unique_ptr<ihs::render::LiveWindow> window;
   if (want_window) {
     try {
-      window = std::make_unique<ihs::render::LiveWindow>("inhandscan", 1280, 508);
+      int width = 0, height = 0;
+      ihs::app::LiveScreenSize(pipeline.intrinsics(), &width, &height);
+      window = std::make_unique<ihs::render::LiveWindow>("inhandscan", width, height);
     } catch (const ihs::DeviceError& error) {
       spdlog::warn("{}; scanning without a window (export: kill -USR1 {}; stop: Ctrl-C)",
                    error.what(), getpid());

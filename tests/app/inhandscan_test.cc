@@ -322,6 +322,7 @@ TEST_F(InhandscanSignalTest, ScreenshotsWithAndWithoutAWindow) {
   EXPECT_EQ(windowed.err.find("scanning without a window"), std::string::npos) << windowed.err;
   const cv::Mat window = cv::imread((dir / "window.png").string());
   ASSERT_FALSE(window.empty()) << windowed.err;
+  EXPECT_EQ(window.size(), screen.size()) << "the window opens at the screen's size";
   EXPECT_GT(GreenPixelsAtTheBottom(window, window.rows / 10), 20);
 }
 

@@ -112,6 +112,10 @@ TEST(LiveScreenTest, LabelsAndStatesAreDrawn) {
   progress.object = "lost";
   progress.coverage = 0.63;
   const RgbImage screen = ComposeLiveScreen(view, kCamera, progress);
+  int width = 0, height = 0;
+  LiveScreenSize(kCamera, &width, &height);
+  ASSERT_EQ(screen.width, width);
+  ASSERT_EQ(screen.height, height);
   ASSERT_EQ(screen.width, 2 * kCamera.width);
   ASSERT_GT(screen.height, kCamera.height);
   auto count = [&](int v0, int v1, int u0, int u1, auto&& pick) {
