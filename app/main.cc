@@ -234,6 +234,7 @@ class StopGuard {
     const bool exported = pipeline_.WaitForFinalExport(std::chrono::milliseconds(0));
     if (!exported && now - *abandoned_at_ <= grace_ + kExportWait) return;
     const std::string saved = ihs::app::ScanFileNamesIn(folder_);
+    ihs::ProgressLine::OnStderr().End();  // The error on a line of its own.
     std::fprintf(stderr, "inhandscan: error: %s\n",
                  ihs::OneLine("a stage did not finish its frame after the stop; " +
                               (saved.empty() ? std::string("nothing could be saved")

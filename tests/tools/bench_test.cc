@@ -16,6 +16,7 @@
 #include "tools/bench/bench_run.h"
 #include "tools/bench/open3d_baseline.h"
 #include "tools/bench/plot.h"
+#include "tools/bench/report.h"
 
 namespace ihs::bench {
 namespace {
@@ -241,6 +242,39 @@ TEST(BenchToolTest, QuickReportHasEveryTableFileAndMethod) {
   EXPECT_TRUE(ours_sphere);
   const int methods = 4 + 5 + (Open3dAvailable() ? 1 : 0);  // Ours, 3 baselines, 5 more γt.
   EXPECT_EQ(rows, (data.empty() ? 2 : 3) * methods);
+}
+
+// A method that lost the object (a mesh of the scene: a diameter of 268 million mm) is reported
+// as lost, not by its numbers, and is left out of the paper sessions' mean, which says so.
+TEST(ReportTest, AMethodThatLostTheObjectIsReportedAsLost) {
+  const test::TempDir dir;
+  CaseResult session;
+  session.bench_case = {"004-sphere", "sphere", "recorded:x", false, 300, true};
+  auto method = [](const std::string& name, double diameter_mm, double drift_mm) {
+    MethodResult m;
+    m.method = name;
+    m.ok = true;
+    m.frames = m.registered = 300;
+    m.measures["dimensions"] = {
+        {{"measure", "diameter"}, {"truth_mm", 70.0}, {"scan_mm", diameter_mm}}};
+    m.measures["dimensions_watertight"] = m.measures["dimensions"];
+    m.measures["trajectory_error_mm"] = {{"mean", drift_mm}};
+    m.measures["chamfer_mm"] = 1.0;
+    m.measures["completeness"] = 0.9;
+    return m;
+  };
+  session.methods = {method("ours", 70.4, 2.0), method("visual-only", 268435456.0, 3.0),
+                     method("no-icp", 71.0, 312.0)};
+  const std::vector<Method> methods = {{"ours"}, {"visual-only", 0}, {"no-icp", 15, true, false}};
+  ReportOptions options;
+  options.out = dir.path();
+  options.mesh_pictures = false;
+  const std::string md = WriteReport({session}, methods, options);
+  EXPECT_EQ(md.find("268435456"), std::string::npos);
+  EXPECT_NE(md.find("lost (a dimension"), std::string::npos) << md;
+  EXPECT_NE(md.find("lost (drift 312 mm)"), std::string::npos) << md;
+  EXPECT_NE(md.find("70.4 (+0.4)"), std::string::npos) << md;  // Ours, as measured.
+  EXPECT_NE(md.find("(1 lost)"), std::string::npos) << md;
 }
 
 TEST(BenchToolTest, BadInputIsOneLine) {

@@ -8,6 +8,7 @@
 #include <ctime>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -146,6 +147,39 @@ void AppendMethodCells(std::vector<std::string>& row, const CaseResult& r,
     const MethodResult* m = Find(r, name);
     row.push_back(m && m->ok ? cell_of(*m) : missing);
   }
+}
+
+/// Why `m` counts as having lost the object in its case, or nothing: its mean drift is larger
+/// than the object (its largest true dimension; 100 mm where the case has none), or a dimension
+/// it measured is off by more than the dimension itself (it meshed the scene, not the object).
+/// Its numbers then say nothing about the object: the tables print "lost" instead.
+std::optional<std::string> LostReason(const MethodResult& m) {
+  double size = 0, worst = 0;
+  for (const auto& row : m.measures.value("dimensions", json::array())) {
+    const double truth = row.value("truth_mm", 0.0);
+    size = std::max(size, truth);
+    const double error = std::abs(row.value("scan_mm", 0.0) - truth);
+    if (truth > 0 && !(error <= truth)) worst = std::max(worst, error / truth);
+  }
+  const double drift = Number(m.measures, "trajectory_error_mm", "mean");
+  if (std::isfinite(drift) && drift > (size > 0 ? size : 100.0))
+    return "lost (drift " + Format("%.0f", drift) + " mm)";
+  if (worst > 0) return "lost (a dimension " + Format("%.0f", worst) + "× off)";
+  return std::nullopt;
+}
+
+/// AppendMethodCells for the object's measures: "lost" where the method lost the object.
+template <typename CellOf>
+void AppendObjectCells(std::vector<std::string>& row, const CaseResult& r,
+                       const std::vector<std::string>& compared, CellOf cell_of,
+                       const char* missing = "failed") {
+  AppendMethodCells(
+      row, r, compared,
+      [&](const MethodResult& m) -> std::string {
+        if (const auto lost = LostReason(m)) return *lost;
+        return cell_of(m);
+      },
+      missing);
 }
 
 /// The method's time per frame in its object stage (SIFT + fusion), ms.
@@ -332,8 +366,11 @@ void ReportWriter::Introduction() {
         "(γt = 15), **visual-only** (γt = 0), **contacts-only** (no SIFT), **no-icp**, and "
         "**open3d** (Open3D's RGB-D odometry + scalable TSDF, frame to frame, on the same frames "
         "with the hand's pixels removed by the ground truth). Every method's mesh goes through "
-        "the same smoothing and Poisson. Dimensions are measured on the seen surface, the volume "
-        "on the watertight mesh.\n\n";
+        "the same smoothing and Poisson. Dimensions are measured on the seen surface and again on "
+        "the watertight mesh a user takes away (mesh.ply), the volume on the watertight mesh. A "
+        "method whose mean drift is larger than the object, or that measures a dimension off by "
+        "more than the dimension itself, lost the object: its cells say \"lost\" and the paper "
+        "sessions' means leave it out (and say how many).\n\n";
   md << "| case | object | motion | frames |\n|---|---|---|---:|\n";
   for (const CaseResult& r : results) {
     const BenchCase& c = r.bench_case;
@@ -359,7 +396,7 @@ void ReportWriter::DimensionRows(const CaseResult& r, const std::string& key, Ta
     const double truth = row["truth_mm"].get<double>();
     std::vector<std::string> cells = {r.bench_case.name, row["measure"].get<std::string>(),
                                       Format("%.1f", truth)};
-    AppendMethodCells(cells, r, compared, [&](const MethodResult& m) -> std::string {
+    AppendObjectCells(cells, r, compared, [&](const MethodResult& m) -> std::string {
       if (!m.measures.contains(key) || m.measures[key].size() <= d) return "failed";
       const double scan = m.measures[key][d]["scan_mm"].get<double>();
       if (r.bench_case.paper) errors[m.method].push_back(std::abs(scan - truth));
@@ -382,7 +419,13 @@ Table ReportWriter::DimensionTable(const std::string& key) {
   std::vector<std::string> mean_row = {"**paper sessions**", "**mean abs. error**", ""};
   for (const auto& name : compared) {
     const auto& e = errors[name];
-    mean_row.push_back(e.empty() ? "–" : "**" + Format("%.2f", Mean(e)) + "**");
+    int lost = 0;  // Paper sessions left out of the mean: the method lost the object there.
+    for (const CaseResult& r : results) {
+      const MethodResult* m = Find(r, name);
+      lost += r.bench_case.paper && m && m->ok && LostReason(*m);
+    }
+    mean_row.push_back((e.empty() ? "–" : "**" + Format("%.2f", Mean(e)) + "**") +
+                       (lost ? " (" + std::to_string(lost) + " lost)" : ""));
   }
   if (!errors.empty()) table.rows.push_back(mean_row);
   return table;
@@ -396,7 +439,7 @@ void ReportWriter::Table1() {
   for (const CaseResult& r : results) {
     if (r.bench_case.object != "sphere") continue;
     std::vector<std::string> cells = {r.bench_case.name, "volume error", ""};
-    AppendMethodCells(cells, r, compared, VolumeCell, "–");
+    AppendObjectCells(cells, r, compared, VolumeCell, "–");
     table1.rows.push_back(cells);
     sphere_volume = true;
   }
@@ -476,12 +519,13 @@ void ReportWriter::SurfaceDriftSpeed() {
     const std::string joint = Cell(r.joint_error_mm, "%.1f mm");
     std::vector<std::string> su = {r.bench_case.name, joint}, dr = su;
     std::vector<std::string> sp = {r.bench_case.name, Format("%.1f", r.track_ms + r.mask_ms)};
-    AppendMethodCells(su, r, compared, [](const MethodResult& m) {
+    AppendObjectCells(su, r, compared, [](const MethodResult& m) {
       return Cell(Number(m.measures, "chamfer_mm")) + " / " +
              Cell(100 * Number(m.measures, "completeness"), "%.0f %%");
     });
     AppendMethodCells(dr, r, compared, [](const MethodResult& m) {
-      return Cell(Number(m.measures, "trajectory_error_mm", "mean"), "%.1f");
+      const std::string drift = Cell(Number(m.measures, "trajectory_error_mm", "mean"), "%.1f");
+      return LostReason(m) ? drift + " (lost)" : drift;
     });
     AppendMethodCells(sp, r, compared, [](const MethodResult& m) {
       return Format("%.1f", ObjectStageMs(m.measures));
