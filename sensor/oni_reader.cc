@@ -10,12 +10,12 @@
 #include <cmath>
 #include <cstring>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
 #include "core/errors.h"
 #include "sensor/depth_codec.h"
+#include "sensor/jpeg_decoder.h"
 
 namespace ihs::sensor {
 namespace {
@@ -374,13 +374,9 @@ bool DecodeOniColor(std::string_view bytes, const OniNode& node, const OniFrameR
     return true;
   }
   if (node.codec != kOniCodecJpeg) return false;
-  const cv::Mat encoded(1, static_cast<int>(record.payload_size), CV_8UC1, const_cast<char*>(data));
-  cv::Mat bgr;
-  try {
-    bgr = cv::imdecode(encoded, cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    return false;
-  }
+  std::string problem;  // The caller skips the colour frame; libjpeg's reason is not needed.
+  const cv::Mat bgr = DecodeJpeg(std::string_view(data, record.payload_size),
+                                 static_cast<std::uint64_t>(node.width) * node.height, &problem);
   if (bgr.empty() || bgr.cols != node.width || bgr.rows != node.height) return false;
   rgb.resize(size);
   cv::Mat out(node.height, node.width, CV_8UC3, rgb.data());

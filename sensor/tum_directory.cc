@@ -20,6 +20,7 @@
 #include "core/check.h"
 #include "core/data_lines.h"
 #include "core/errors.h"
+#include "sensor/jpeg_decoder.h"
 #include "sensor/png_decoder.h"
 
 namespace ihs::sensor {
@@ -82,6 +83,8 @@ cv::Mat ReadImage(const fs::path& path, int flags, std::string* problem) {
     return {};
   }
   if (IsPng(bytes)) return DecodePng(bytes, flags == cv::IMREAD_ANYDEPTH, kMaxImagePixels, problem);
+  // A JPEG is never a depth image: as colour, it fails the depth check by its type.
+  if (IsJpeg(bytes)) return DecodeJpeg(bytes, kMaxImagePixels, problem);
   cv::Mat image;
   if (!bytes.empty()) {
     try {

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Fuzzes the readers of untrusted input with libFuzzer (clang, ASan + UBSan): the .oni reader,
-# TUM folder lists and their PNG images, the mesh readers (PLY, OBJ, STL) and the config parser. Builds the targets
-# in build-fuzz, runs each for SECONDS from a small seed corpus and prints, per target, the
-# executions and the failing inputs — crashes, timeouts (20 s), out-of-memory (2 GiB) — kept under
+# TUM folder lists and their PNG images, the JPEG decoder (.oni colour frames, TUM images), the
+# mesh readers (PLY, OBJ, STL) and the config parser. Builds the targets in build-fuzz, runs each
+# for SECONDS from a small seed corpus and prints, per target, the executions and the failing
+# inputs — crashes, timeouts (20 s), out-of-memory (2 GiB) — kept under
 # build-fuzz/tools/fuzz/work/TARGET/crashes: make each one a test. Exit 1 when any input failed.
 #   tools/fuzz.sh [SECONDS] [TARGET ...]     (default: 60 s each, every target)
 set -euo pipefail
@@ -11,7 +12,8 @@ seconds="${1:-60}"
 [[ $# -gt 0 ]] && shift
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] &&
-  targets=(oni_reader_fuzzer tum_folder_fuzzer png_decoder_fuzzer mesh_reader_fuzzer config_fuzzer)
+  targets=(oni_reader_fuzzer tum_folder_fuzzer png_decoder_fuzzer jpeg_decoder_fuzzer
+    mesh_reader_fuzzer config_fuzzer)
 [[ "$seconds" =~ ^[0-9]+$ && "$seconds" -ge 1 ]] || {
   echo "fuzz: SECONDS must be a positive whole number, got '$seconds'" >&2
   exit 2
@@ -52,6 +54,33 @@ colour = png(8, 6, 8, 2, lambda y: bytes((30 * x, 40 * y, 200) [c] for x in rang
 open(sys.argv[1] + "/depth", "wb").write(b"\1" + depth)
 open(sys.argv[1] + "/colour", "wb").write(b"\0" + colour)
 PY
+      ;;
+    jpeg_decoder_fuzzer)
+      # 8x6-pixel JPEGs written by OpenCV: colour, progressive colour, and grey with restart
+      # markers.
+      base64 -d >"$corpus/colour" <<'B64'
+/9j/4AAQSkZJRgABAQAAAQABAAD/2wBDAAIBAQEBAQIBAQECAgICAgQDAgICAgUEBAMEBgUGBgYFBgYGBwkIBgcJBwYGCAsI
+CQoKCgoKBggLDAsKDAkKCgr/2wBDAQICAgICAgUDAwUKBwYHCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoK
+CgoKCgoKCgoKCgoKCgr/wAARCAAGAAgDASIAAhEBAxEB/8QAFQABAQAAAAAAAAAAAAAAAAAAAAf/xAAfEAABAAsAAAAAAAAA
+AAAAAAAAAQIEBgcJESNBQ9H/xAAVAQEBAAAAAAAAAAAAAAAAAAAFB//EACIRAAAEBAcAAAAAAAAAAAAAAAABAgYEBQckFBdR
+YZGh0f/aAAwDAQACEQMRAD8AorgysIa1UuMeNSeAAMoI9XVl5D3a+tC2FimlQnrizvl8l4P/2Q==
+B64
+      base64 -d >"$corpus/progressive" <<'B64'
+/9j/4AAQSkZJRgABAQAAAQABAAD/2wBDAAIBAQEBAQIBAQECAgICAgQDAgICAgUEBAMEBgUGBgYFBgYGBwkIBgcJBwYGCAsI
+CQoKCgoKBggLDAsKDAkKCgr/2wBDAQICAgICAgUDAwUKBwYHCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoKCgoK
+CgoKCgoKCgoKCgoKCgr/wgARCAAGAAgDASIAAhEBAxEB/8QAFQABAQAAAAAAAAAAAAAAAAAAAAb/xAAVAQEBAAAAAAAAAAAA
+AAAAAAAEBv/aAAwDAQACEAMQAAABogWx/8QAFxAAAwEAAAAAAAAAAAAAAAAAAAQFB//aAAgBAQABBQJDLJp//8QAGhEAAAcA
+AAAAAAAAAAAAAAAAAAEEBQYTM//aAAgBAwEBPwFVIXq3cx//xAAaEQABBQEAAAAAAAAAAAAAAAAFAAEDBhYj/9oACAECAQE/
+AaEaK56Pq6//xAAXEAADAQAAAAAAAAAAAAAAAAAAAjGR/9oACAEBAAY/AqmH/8QAFRABAQAAAAAAAAAAAAAAAAAAACH/2gAI
+AQEAAT8hnD//2gAMAwEAAgADAAAAEPv/xAAYEQACAwAAAAAAAAAAAAAAAAAAARGx0f/aAAgBAwEBPxCTtWH/xAAYEQACAwAA
+AAAAAAAAAAAAAAAAAVFh0f/aAAgBAgEBPxDNcKj/xAAYEAACAwAAAAAAAAAAAAAAAAAAEUFh0f/aAAgBAQABPxBqpPD/2Q==
+B64
+      base64 -d >"$corpus/grey" <<'B64'
+/9j/4AAQSkZJRgABAQAAAQABAAD/2wBDAAIBAQEBAQIBAQECAgICAgQDAgICAgUEBAMEBgUGBgYFBgYGBwkIBgcJBwYGCAsI
+CQoKCgoKBggLDAsKDAkKCgr/wAALCAAGAAgBAREA/8QAFAABAAAAAAAAAAAAAAAAAAAABP/EAB0QAAICAgMBAAAAAAAAAAAA
+AAECAwQFBgcICSH/3QAEAAH/2gAIAQEAAD8AB4w63xt1q4CznYzeqNu3hNA0+/smZq4mBJLU1WjVktSpCsjojSlImChnRSxA
+LKPo/9k=
+B64
       ;;
     mesh_reader_fuzzer)
       printf '\000ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$corpus/ply"

@@ -119,6 +119,36 @@ TEST(OniReaderTest, AgreesWithOpenNi2BitForBitOnTheRealKinectRecording) {
   }
 }
 
+// A colour frame whose JPEG libjpeg finds damaged (here an end marker inside its data) plays
+// without colour, and libjpeg prints nothing (through OpenCV it printed "Corrupt JPEG data:
+// premature end of data segment" and gave a damaged image).
+TEST(OniReaderTest, ADamagedJpegColourFramePlaysWithoutColourAndSilently) {
+  const auto path = test::KinectRecording();
+  if (path.empty()) GTEST_SKIP() << "../shared/data is absent";
+  std::string bytes = test::ReadFileString(path);
+  const OniIndex index = IndexOni(bytes, "real");
+  const OniNode& color = *index.FirstOfType(OniNodeType::kImage);
+  ASSERT_EQ(color.codec, kOniCodecJpeg);
+  const OniFrameRecord& damaged = color.frames.at(4);
+  bytes.replace(damaged.payload_offset + damaged.payload_size / 2, 2, "\xFF\xD9");
+  test::TempDir dir;
+  test::WriteBytes(dir / "damaged.oni", bytes);
+  const auto reference = ReadWithOwnReader(path);
+  testing::internal::CaptureStderr();
+  const auto frames = ReadWithOwnReader(dir / "damaged.oni");
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  ASSERT_EQ(frames.size(), reference.size());
+  int without_colour = 0;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const bool paired = reference[i]->color_timestamp_us == std::int64_t(damaged.timestamp_us);
+    without_colour += paired;
+    EXPECT_EQ(frames[i]->rgb.empty(), paired) << i;
+    if (!paired) EXPECT_EQ(frames[i]->rgb, reference[i]->rgb) << i;
+    EXPECT_EQ(frames[i]->depth_mm, reference[i]->depth_mm) << i;
+  }
+  EXPECT_EQ(without_colour, 1);
+}
+
 TEST(OniReaderTest, RecoversEveryCompleteFrameOfATruncatedRecording) {
   const auto path = test::KinectRecording();
   if (path.empty()) GTEST_SKIP() << "../shared/data is absent";

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <regex>
+#include <sstream>
 
 #include "core/errors.h"
 #include "tests/frame_fixtures.h"
@@ -24,6 +26,15 @@ void WriteFrames(const std::filesystem::path& folder, const std::vector<Frame>& 
   TumWriter writer(folder, intrinsics);
   for (const Frame& frame : frames) writer.Write(frame);
   writer.Finish();
+}
+
+// Every frame of `source`, and what reading them printed on stderr.
+std::vector<std::shared_ptr<const Frame>> ReadPrinting(TumDirectorySource& source,
+                                                       std::string* printed) {
+  testing::internal::CaptureStderr();
+  auto frames = test::ReadAllFrames(source);
+  *printed = testing::internal::GetCapturedStderr();
+  return frames;
 }
 
 TEST(TumDirectoryTest, RoundTripsDepthColourTimestampsAndIntrinsicsExactly) {
@@ -111,12 +122,53 @@ TEST(TumDirectoryTest, DamagedPngsAreSkippedWithOneLineAndLibpngSaysNothing) {
   const std::string colour = test::ReadFileString(dir / entries[2].color_path);
   test::WriteBytes(dir / entries[2].color_path, colour.substr(0, colour.size() / 2));
   TumDirectorySource source(dir.path());
-  testing::internal::CaptureStderr();
-  const auto frames = test::ReadAllFrames(source);
-  const std::string printed = testing::internal::GetCapturedStderr();
+  std::string printed;
+  const auto frames = ReadPrinting(source, &printed);
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(source.SkippedFrames(), 2);
   EXPECT_EQ(printed.find("libpng"), std::string::npos) << printed;
+}
+
+// JPEG colour images (TUM's own recordings, Open3D's) are decoded by libjpeg directly: good ones
+// read as OpenCV reads them, a damaged one skips its frame with the scanner's one-line warning,
+// and libjpeg prints nothing of its own (through OpenCV it printed "Premature end of JPEG file"
+// and "Corrupt JPEG data" lines, and returned the damaged images as frames).
+TEST(TumDirectoryTest, DamagedJpegsAreSkippedWithOneLineAndLibjpegSaysNothing) {
+  test::TempDir dir;
+  WriteFrames(dir.path(), test::MakePatternFrames(4, 64, 48), CameraIntrinsics{}.Scaled(64, 48));
+  const std::regex png_colour("(rgb/[0-9.]+)\\.png");
+  for (const char* list : {"rgb.txt", "associations.txt"}) {
+    test::WriteBytes(dir / list,
+                     std::regex_replace(test::ReadFileString(dir / list), png_colour, "$1.jpg"));
+  }
+  const auto entries = ListTumDirectory(dir.path(), TumOptions{});
+  ASSERT_EQ(entries.size(), 4u);
+  std::vector<cv::Mat> expected;
+  for (const TumEntry& entry : entries) {
+    const std::filesystem::path png =
+        dir / std::regex_replace(entry.color_path, std::regex("\\.jpg$"), ".png");
+    std::vector<std::uint8_t> jpeg;
+    ASSERT_TRUE(cv::imencode(".jpg", cv::imread(png.string(), cv::IMREAD_COLOR), jpeg));
+    test::WriteBytes(dir / entry.color_path, std::string(jpeg.begin(), jpeg.end()));
+    cv::Mat rgb;
+    cv::cvtColor(cv::imdecode(jpeg, cv::IMREAD_COLOR), rgb, cv::COLOR_BGR2RGB);
+    expected.push_back(rgb);
+  }
+  const std::string jpeg = test::ReadFileString(dir / entries[1].color_path);
+  test::WriteBytes(dir / entries[1].color_path, jpeg.substr(0, jpeg.size() * 3 / 4));
+  TumDirectorySource source(dir.path());
+  std::string printed;
+  const auto frames = ReadPrinting(source, &printed);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(source.SkippedFrames(), 1);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const cv::Mat& rgb = expected[i == 0 ? 0 : i + 1];
+    EXPECT_EQ(frames[i]->rgb, std::vector<std::uint8_t>(rgb.data, rgb.data + rgb.total() * 3)) << i;
+  }
+  std::istringstream lines(printed);  // Only the scanner's own warnings, if any go to stderr.
+  for (std::string line; std::getline(lines, line);) {
+    EXPECT_NE(line.find("skipping a frame"), std::string::npos) << line;
+  }
 }
 
 // Colour images in PNG's other forms (grey, colour with alpha) read as the same colours.
