@@ -102,10 +102,22 @@ void DrawModelPanel(cv::Mat panel, const LiveView& view) {
   }
 }
 
+
+// The status line's pieces, each in its colour: the states coloured by how they stand.
+std::vector<std::pair<std::string, cv::Scalar>> StatusSegments(const PipelineProgress& progress) {
+  return {{"hand: ", kText},
+          {progress.hand, StateColour(progress.hand)},
+          {" | object: ", kText},
+          {progress.object, StateColour(progress.object)},
+          {" | " + CountsText(progress), kText}};
+}
+
 }  // namespace
 
 std::string StatusLine(const PipelineProgress& progress) {
-  return "hand: " + progress.hand + " | object: " + progress.object + " | " + CountsText(progress);
+  std::string line;
+  for (const auto& [text, colour] : StatusSegments(progress)) line += text;
+  return line;
 }
 
 void LiveScreenSize(const CameraIntrinsics& intrinsics, int* width, int* height) {
@@ -120,12 +132,7 @@ RgbImage ComposeLiveScreen(const LiveView& view, const CameraIntrinsics& intrins
   cv::Mat screen(height + kStatusHeight, 2 * width, CV_8UC3, kBackground);
   DrawCameraPanel(screen(cv::Rect(0, 0, width, height)), view, intrinsics);
   DrawModelPanel(screen(cv::Rect(width, 0, width, height)), view);
-  DrawSegments(screen, 8, height + 19,
-               {{"hand: ", kText},
-                {progress.hand, StateColour(progress.hand)},
-                {" | object: ", kText},
-                {progress.object, StateColour(progress.object)},
-                {" | " + CountsText(progress), kText}});
+  DrawSegments(screen, 8, height + 19, StatusSegments(progress));
   DrawSegments(screen, 8, height + 40,
                {{"keys: s save the mesh now, r start anew, c the camera's view, q finish "
                  "(export and quit); drag the model to turn it",

@@ -17,7 +17,8 @@ class LiveWindow;
 
 namespace ihs::app {
 
-/// The status bar's first line: hand and object state, share seen, frame rate and counts.
+/// The status bar's first line as text (the screen draws it with the states in colour): hand
+/// and object state, share seen, frame rate and counts.
 std::string StatusLine(const PipelineProgress& progress);
 
 /// The size of ComposeLiveScreen's image for a camera with `intrinsics`: the window's size.
