@@ -41,6 +41,7 @@ void ScanRecord::Add(const FramePacket& packet) {
     ++track_counts_[tracker::ToString(track.status)];
     if (!track.reason.empty()) entry["track_reason"] = track.reason;
     if (track.doubtful) entry["track_doubtful"] = true, ++doubtful_frames_;
+    if (track.turned_over) entry["track_turned_over"] = true, ++turned_over_frames_;
     timing("track_ms", track.milliseconds);
     timing("segmentation_ms", track.segmentation_ms);
     timing("hand_fit_ms", track.fit_ms);
@@ -132,6 +133,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"registered_frames", registered()},
                             {"track_status_counts", track_counts_},
                             {"hand_doubtful_frames", doubtful_frames_},
+                            {"hand_turned_over_frames", turned_over_frames_},
                             {"fusion_status_counts", fusion_counts_},
                             {"skip_reasons", skip_reasons_},
                             {"coverage", coverage_},

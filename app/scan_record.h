@@ -64,6 +64,8 @@ class ScanRecord {
   std::vector<std::string> angle_names_;
   std::int64_t frames_ = 0;
   std::int64_t doubtful_frames_ = 0;  // Frames whose hand pose was doubtful.
+  // Frames where the fit turned over (palm for back) replaced the tracked one.
+  std::int64_t turned_over_frames_ = 0;
   std::vector<std::string> frame_json_;  // One serialised object per recorded frame.
   std::map<std::string, std::int64_t> track_counts_, fusion_counts_, skip_reasons_;
   std::map<std::string, std::pair<double, std::int64_t>> stage_ms_;  // Sum and count.

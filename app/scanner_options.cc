@@ -200,6 +200,10 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
         "frames over which the template's scale is estimated (0: none)");
   r.Add("tracker.scale_range", &t.scale_range, "scale candidates span 1 ± this");
   r.Add("tracker.scale_step", &t.scale_step, "step between scale candidates");
+  r.Add("tracker.flip_check_frames", &t.flip_check_frames,
+        "frames between fits of the hand turned over (palm for back) beside the fit (0: never)");
+  r.Add("tracker.flip_tie_score", &t.flip_tie_score,
+        "fit scores this close make the turned-over fit a tie and the pose doubtful");
   AddSegmentationOptions(r, &t.segmentation);
   AddHandFitOptions(r, &t.fit);
   AddContactOptions(r, &t.contacts);

@@ -142,9 +142,13 @@ class TrackLog {
   void AddErrors(std::int64_t index, const TrackResult& result, nlohmann::json& entry) {
     if (!truth_.joints.empty() && index < static_cast<std::int64_t>(truth_.joints.size()) &&
         !result.joints_mm.empty()) {
-      joint_errors_.push_back(
-          ihs::tracker::MeanJointError(result.joints_mm, truth_.joints[index].joints_mm));
+      const auto& truth = truth_.joints[index].joints_mm;
+      joint_errors_.push_back(ihs::tracker::MeanJointError(result.joints_mm, truth));
       entry["joint_error_mm"] = joint_errors_.back();
+      const ihs::tracker::HandSides sides =
+          ihs::tracker::CompareHandSides(model_, result.joints_mm, truth);
+      if (sides.turned_over()) entry["turned_over"] = true, ++turned_over_;
+      if (sides.palm_reversed) entry["palm_reversed"] = true, ++palm_reversed_;
     }
     if (index > 0 && index < static_cast<std::int64_t>(truth_.trajectory.size())) {
       const ihs::Rigid3 motion =
@@ -178,6 +182,8 @@ class TrackLog {
       for (double e : joint_errors_) sum += e;
       summary["joint_error_mm_mean"] = sum / joint_errors_.size();
       summary["joint_error_mm_p95"] = Quantile(joint_errors_, 0.95);
+      summary["turned_over_frames"] = turned_over_;
+      summary["palm_reversed_frames"] = palm_reversed_;
     }
     if (!contact_errors_.empty()) {
       summary["contact_error_mm_median"] = Quantile(contact_errors_, 0.5);
@@ -207,9 +213,11 @@ class TrackLog {
         summary["segmentation_ms_mean"].get<double>(), summary["fit_ms_mean"].get<double>(),
         summary["contacts_ms_mean"].get<double>());
     if (!joint_errors_.empty()) {
-      std::printf("joint error: %.2f mm mean, %.2f mm p95 over %zu frames\n",
-                  summary["joint_error_mm_mean"].get<double>(), Quantile(joint_errors_, 0.95),
-                  joint_errors_.size());
+      std::printf(
+          "joint error: %.2f mm mean, %.2f mm p95 over %zu frames; turned over in %d (palm for "
+          "back in %d, the others' thumb tip nearer the true little fingertip)\n",
+          summary["joint_error_mm_mean"].get<double>(), Quantile(joint_errors_, 0.95),
+          joint_errors_.size(), turned_over_, palm_reversed_);
     }
     if (!contact_errors_.empty()) {
       std::printf("contact error: %.2f mm median over %zu contact pairs\n",
@@ -226,6 +234,8 @@ class TrackLog {
   nlohmann::json frames_ = nlohmann::json::array();
   std::map<std::string, int> counts_;
   int doubtful_ = 0;  // Frames whose pose was doubtful.
+  // Frames fitted turned over against the truth (CompareHandSides), and palm for back.
+  int turned_over_ = 0, palm_reversed_ = 0;
   std::vector<double> joint_errors_, contact_errors_, milliseconds_;
   double stage_ms_[3] = {0, 0, 0};
 };

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "tracker/hand_model.h"
+
 namespace ihs::tracker {
 
 /// The joints of one frame.
@@ -31,5 +33,22 @@ std::vector<HandJointsRow> ReadHandJointsCsv(const std::filesystem::path& path);
 /// joints, mm. Throws std::invalid_argument unless both have the same, non-zero count.
 double MeanJointError(const std::vector<Eigen::Vector3d>& estimate_mm,
                       const std::vector<Eigen::Vector3d>& truth_mm);
+
+/// An estimate of the hand against the truth by issue 32's per-frame tests.
+struct HandSides {
+  /// The estimate's thumb tip is nearer the true little fingertip than the true thumb tip.
+  bool thumb_swapped = false;
+  /// The estimate's palm normal (little to index knuckle × first joint to middle knuckle) is
+  /// more than 90° from the truth's: palm for back.
+  bool palm_reversed = false;
+  /// Either: the hand is fitted turned over (a flip, where it lasts more than 10 frames).
+  bool turned_over() const { return thumb_swapped || palm_reversed; }
+};
+
+/// Compares an estimate's sides with the truth's. `model` gives the joints' layout
+/// (HandModel::JointPositions; the bones named "RFing.<finger>_Hand", and the fingers' end
+/// effectors). Throws std::invalid_argument for other layouts.
+HandSides CompareHandSides(const HandModel& model, const std::vector<Eigen::Vector3d>& estimate_mm,
+                           const std::vector<Eigen::Vector3d>& truth_mm);
 
 }  // namespace ihs::tracker

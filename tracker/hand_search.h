@@ -68,4 +68,10 @@ class HandSearch {
 /// toward the palm (root pose: identity).
 HandPose CurledHand(const HandModel& model, double fraction);
 
+/// `pose` turned over: its root turned 180° about the hand's long axis (the wrist to the middle
+/// finger's knuckle) through the palm's middle (the wrist and the four knuckles' centroid), so
+/// the palm faces where the back did and the thumb lies where the little finger did; the
+/// articulation is kept. The ambiguity a depth fit can tie on (docs/tracker.md).
+HandPose TurnedOver(const HandModel& model, const HandPose& pose);
+
 }  // namespace ihs::tracker

@@ -61,6 +61,10 @@ void TrackerOptions::Check() const {
   IHS_CHECK_ARG(scale_frames >= 0 && scale_frames <= 300,
                 "tracker.scale_frames must be in [0, 300]");
   IHS_CHECK_ARG(scale_range >= 0 && scale_range < 0.5, "tracker.scale_range must be in [0, 0.5)");
+  IHS_CHECK_ARG(flip_check_frames >= 0 && flip_check_frames <= 100000,
+                "tracker.flip_check_frames must be in [0, 100000]");
+  IHS_CHECK_ARG(flip_tie_score >= 0 && flip_tie_score <= 100,
+                "tracker.flip_tie_score must be in [0, 100]");
   IHS_CHECK_ARG(scale_step > 0 && scale_range <= 50 * scale_step,
                 "tracker.scale_step must be positive and at least scale_range / 50 (at most 101 "
                 "scales tried)");
@@ -220,6 +224,20 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
   return best;
 }
 
+bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points,
+                                  const Frame& frame, TrackResult& result) const {
+  HandFitResult turned = initial_fitter_->Fit(
+      hand_points, &frame, TurnedOver(model_, result.fit.pose), &result.segmentation);
+  const double kept = FitScore(result.fit), other = FitScore(turned);
+  spdlog::debug("frame {}: fit scores {:.2f}, turned over {:.2f}", frame.index, kept, other);
+  if (other < kept) {
+    result.fit = std::move(turned);
+    result.status = TrackStatus::kInitialised;
+    result.turned_over = true;
+  }
+  return std::abs(other - kept) < options_.flip_tie_score;
+}
+
 TrackResult HandTracker::Track(const Frame& frame) {
   const auto started = SteadyClock::now();
   TrackResult result;
@@ -273,11 +291,19 @@ TrackResult HandTracker::Track(const Frame& frame) {
       result.status = TrackStatus::kInitialised;
     }
   }
-  if (result.fit.data_coverage >= options_.search_data_coverage) {
+  // Palm for back: the fit turned over, now and then, and always on a fit found from scratch.
+  bool& tie = result.flip_tie;
+  if (options_.flip_check_frames > 0 && result.fit.data_coverage >= options_.min_data_coverage &&
+      (result.status == TrackStatus::kInitialised ||
+       ++frames_since_flip_check_ >= options_.flip_check_frames)) {
+    frames_since_flip_check_ = 0;
+    tie = CheckTurnedOver(points, frame, result);
+  }
+  if (result.fit.data_coverage >= options_.search_data_coverage && !tie) {
     confident_pose_ = result.fit.pose;
     has_confident_pose_ = true;
   }
-  result.doubtful = result.fit.data_coverage < options_.search_data_coverage;
+  result.doubtful = result.fit.data_coverage < options_.search_data_coverage || tie;
   if (result.fit.data_coverage < options_.min_data_coverage) {
     result.status = TrackStatus::kDiverged;
     result.doubtful = false;  // Not doubtful: diverged.

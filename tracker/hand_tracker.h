@@ -60,6 +60,16 @@ struct TrackerOptions {
   int scale_frames = 10;
   double scale_range = 0.15;
   double scale_step = 0.05;
+  /// Every flip_check_frames frames with a pose, and on every fit found by a search (0:
+  /// never), the fit turned over (TurnedOver: palm for back, thumb for little finger) is fitted
+  /// too (initialisation_iterations), and replaces the fit when it explains the hand better;
+  /// when it explains it within flip_tie_score as well (FitScore's units: mm of mean distance,
+  /// 20 per share of points unexplained), the pose is doubtful. On the 22 generated sequences
+  /// of tools/bench_hand_init.sh (seed 1000) it never came close (turned over 14.6–35 against
+  /// 3.5–9.7, the wrong fits there are misplaced, not turned over) and costs about a tenth more
+  /// fit time at 10 frames (docs/tracker.md); it guards against the held-out palm-for-back fit.
+  int flip_check_frames = 10;
+  double flip_tie_score = 0.5;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -103,8 +113,14 @@ struct TrackResult {
   HandFitResult fit;
   /// The pose is given, but its fit explains fewer than TrackerOptions::search_data_coverage of
   /// the hand points: the hand may be in the wrong place or turned the wrong way round (the
-  /// tracker searches anew after doubtful_frames_to_search such frames in a row).
+  /// tracker searches anew after doubtful_frames_to_search such frames in a row), or its fit
+  /// turned over explains them about as well (TrackerOptions::flip_check_frames).
   bool doubtful = false;
+  /// The fit turned over explained the hand better than the fit and replaced it this frame.
+  bool turned_over = false;
+  /// The fit turned over was tried this frame and explained the hand about as well (within
+  /// TrackerOptions::flip_tie_score): the pose is doubtful.
+  bool flip_tie = false;
   /// The template's scale in use (1 until an estimate is made; see TrackerOptions).
   double hand_scale = 1.0;
   /// Time spent on this frame, ms: in all, and on segmentation, the pose fit (with any
@@ -152,6 +168,10 @@ class HandTracker {
   // The fit from the search's hypotheses that explains the hand best.
   HandFitResult Search(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
                        const Segmentation* segmentation) const;
+  // The fit turned over (TurnedOver), fitted: replaces `result`'s fit when it explains the hand
+  // better; returns whether the two tie (within flip_tie_score).
+  bool CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
+                       TrackResult& result) const;
   // Builds the fitters and the contact detector for model_.
   void BuildStages();
   // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's
@@ -179,6 +199,7 @@ class HandTracker {
   HandPose previous_pose_;
   bool has_previous_ = false;
   int doubtful_in_a_row_ = 0;
+  int frames_since_flip_check_ = 0;
   // The last pose whose fit explained at least search_data_coverage of the hand points.
   HandPose confident_pose_;
   bool has_confident_pose_ = false;

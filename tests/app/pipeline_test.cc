@@ -314,8 +314,13 @@ TEST_F(PipelineFaultTest, MalformedAndEmptyFramesAreSkippedWithTheirReasons) {
   EXPECT_EQ(stats["frames"][9]["fusion"], "skipped");
   // The summary counts the frames whose hand pose was doubtful, as the frames say.
   int doubtful = 0;
-  for (const auto& frame : stats["frames"]) doubtful += frame.value("track_doubtful", false);
+  int turned_over = 0;
+  for (const auto& frame : stats["frames"]) {
+    doubtful += frame.value("track_doubtful", false);
+    turned_over += frame.value("track_turned_over", false);
+  }
   EXPECT_EQ(stats["summary"]["hand_doubtful_frames"], doubtful);
+  EXPECT_EQ(stats["summary"]["hand_turned_over_frames"], turned_over);
   EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
 }
 

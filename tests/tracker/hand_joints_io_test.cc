@@ -5,10 +5,40 @@
 #include "core/errors.h"
 #include "tests/test_util.h"
 #include "tracker/hand_pose.h"
+#include "tracker/hand_search.h"
 #include "tracker/procedural_hand.h"
 
 namespace ihs::tracker {
 namespace {
+
+TEST(HandJointsIoTest, AHandTurnedOverIsToldFromTheTruthAndTurnsBack) {
+  const HandModel hand = MakeProceduralHand();
+  HandPose pose = CurledHand(hand, 0.3);
+  pose.cam_from_root = Rigid3::FromAxisAngle({0.3, 1, 0.2}, 0.8, {10, -20, 550});
+  auto joints = [&](const HandPose& p) { return hand.JointPositions(ForwardKinematics(hand, p)); };
+  const std::vector<Eigen::Vector3d> truth = joints(pose);
+  EXPECT_FALSE(CompareHandSides(hand, truth, truth).turned_over());
+  // A few millimetres and degrees off is not turned over.
+  HandPose near = pose;
+  near.cam_from_root = Rigid3::FromAxisAngle({1, 0, 0}, 0.2, {4, 3, 0}) * pose.cam_from_root;
+  EXPECT_FALSE(CompareHandSides(hand, joints(near), truth).turned_over());
+  const HandPose turned = TurnedOver(hand, pose);
+  const std::vector<Eigen::Vector3d> over = joints(turned);
+  // Palm for back, and the thumb's tip over on the little finger's side.
+  EXPECT_TRUE(CompareHandSides(hand, over, truth).palm_reversed);
+  EXPECT_TRUE(CompareHandSides(hand, over, truth).thumb_swapped);
+  // Only the thumb swung over to the little finger: not palm for back.
+  std::vector<Eigen::Vector3d> thumb_over = truth;
+  const int thumb = hand.BoneIndex("RFing.4_1") + 1, little = hand.BoneIndex("RFing.0_2") + 1;
+  thumb_over[thumb] = truth[little] + Eigen::Vector3d(5, 0, 0);
+  EXPECT_TRUE(CompareHandSides(hand, thumb_over, truth).thumb_swapped);
+  EXPECT_FALSE(CompareHandSides(hand, thumb_over, truth).palm_reversed);
+  // Turned over twice is where it was.
+  const std::vector<Eigen::Vector3d> back = joints(TurnedOver(hand, turned));
+  for (size_t j = 0; j < truth.size(); ++j) EXPECT_LT((back[j] - truth[j]).norm(), 1e-6) << j;
+  EXPECT_THROW(CompareHandSides(hand, {truth.begin(), truth.end() - 1}, truth),
+               std::invalid_argument);
+}
 
 TEST(HandJointsIoTest, RoundTripsTheJointsOfAPosedHandToATenthOfAMicrometre) {
   const HandModel hand = MakeProceduralHand();

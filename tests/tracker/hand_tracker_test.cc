@@ -11,17 +11,12 @@
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
 #include "tracker/hand_data.h"
+#include "tracker/hand_joints_io.h"
+#include "tracker/hand_search.h"
 #include "tracker/procedural_hand.h"
 
 namespace ihs::tracker {
 namespace {
-
-double MeanJointError(const std::vector<Eigen::Vector3d>& a,
-                      const std::vector<Eigen::Vector3d>& b) {
-  double sum = 0;
-  for (size_t j = 0; j < a.size(); ++j) sum += (a[j] - b[j]).norm();
-  return sum / a.size();
-}
 
 synth::SequenceOptions RecordedSphere(int last_frame) {
   synth::SequenceOptions options;
@@ -156,6 +151,52 @@ TEST(HandTrackerTest, InitialisesFromTheOpenHandAndRecoversAfterAJump) {
   EXPECT_LT(after / (renderer.frame_count() - 35), 10.0);  // Recovered within 10 frames.
 }
 
+TEST(HandTrackerTest, AFitTurnedOverMidSequenceIsDoubtedAndTurnedBackWithinAFewFrames) {
+  // The procedural hand turning the sphere, tracked from the truth; at frame 12 the tracker is
+  // told the hand turned over (palm for back), as a wrong search or a fast turn could leave it.
+  synth::SequenceOptions sequence;
+  sequence.scripted.frames = 36;
+  sequence.scripted.turns = 0.25;
+  synth::SequenceRenderer renderer(sequence);
+  struct Outcome {
+    int over = 0;                     // Frames turned over against the truth, or without a pose.
+    int last_over = -1;               // The last of them.
+    bool trusted_while_over = false;  // A turned-over pose given as tracked, undoubted.
+  };
+  auto run = [&](bool recover) {
+    TrackerOptions options;
+    options.scale_frames = 0;
+    if (!recover) options.flip_check_frames = 0, options.doubtful_frames_to_search = 1000;
+    HandTracker tracker(renderer.hand(), renderer.options().intrinsics, options);
+    tracker.Initialise(FitPoseToJoints(renderer.hand(), renderer.Render(0).joints_mm));
+    Outcome outcome;
+    for (int i = 0; i < renderer.frame_count(); ++i) {
+      const synth::RenderedFrame rendered = renderer.Render(i);
+      if (i == 12) {
+        tracker.Initialise(
+            TurnedOver(renderer.hand(), FitPoseToJoints(renderer.hand(), rendered.joints_mm)));
+      }
+      const TrackResult result = tracker.Track(rendered.frame);
+      if (!result.HasPose() ||
+          CompareHandSides(renderer.hand(), result.joints_mm, rendered.joints_mm).turned_over()) {
+        ++outcome.over, outcome.last_over = i;
+        outcome.trusted_while_over |= result.HasPose() && !result.doubtful;
+      }
+    }
+    std::printf("%s: %d frames turned over or lost, the last %d\n",
+                recover ? "searching and checking the flip" : "neither", outcome.over,
+                outcome.last_over);
+    return outcome;
+  };
+  const Outcome recovered = run(true);
+  const int within = TrackerOptions().flip_check_frames;
+  EXPECT_LE(recovered.over, within);
+  EXPECT_LT(recovered.last_over, 12 + within);
+  EXPECT_FALSE(recovered.trusted_while_over);
+  // Neither searching nor checking, the fit stays turned over, or lost, for the rest.
+  EXPECT_GT(run(false).over, (renderer.frame_count() - 12) / 2);
+}
+
 }  // namespace
 }  // namespace ihs::tracker
 
@@ -211,9 +252,11 @@ TEST(HandTrackerTest, SearchesForTheHandAnewWhenItsFitsGrowDoubtful) {
       const synth::RenderedFrame rendered = renderer.Render(i);
       const TrackResult result = tracker.Track(rendered.frame);
       searched += i > 0 && result.status == TrackStatus::kInitialised;
-      // A doubtful pose is one given whose fit explains too little; it is said.
-      EXPECT_EQ(result.doubtful,
-                result.HasPose() && result.fit.data_coverage < search_data_coverage)
+      // A doubtful pose is one given whose fit explains too little, or as little as the fit
+      // turned over; it is said.
+      EXPECT_EQ(
+          result.doubtful,
+          result.HasPose() && (result.fit.data_coverage < search_data_coverage || result.flip_tie))
           << "frame " << i;
       EXPECT_EQ(result.State().find("(doubtful)") != std::string::npos, result.doubtful);
       doubtful += result.doubtful;
