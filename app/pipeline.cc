@@ -431,6 +431,7 @@ void Pipeline::ExportLoop() {
                                 {"self_intersections", exported.meshes.self_intersections},
                                 {"unseen_share", exported.meshes.unseen_share},
                                 {"cut_share", exported.meshes.cut_share},
+                                {"hull_cut_share", exported.meshes.hull_cut_share},
                                 {"volume_mm3", exported.meshes.watertight.IsWatertight()
                                                    ? exported.meshes.watertight.Volume()
                                                    : 0.0}}}};

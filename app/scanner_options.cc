@@ -287,6 +287,9 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
         "lattice step of the closed mesh cut back to the space not seen empty, mm");
   r.Add("mesh.bound_keep_seen_mm", &m.bound_keep_seen_mm,
         "nothing within this of the seen surface is cut, mm");
+  r.Add("mesh.bound_by_seen_hull", &m.bound_by_seen_hull,
+        "also cut the closed mesh to the convex hull of the seen surface (a bottle's unseen base "
+        "ends flat at the lowest seen ring)");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
 }
 

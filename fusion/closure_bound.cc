@@ -8,6 +8,7 @@
 
 #include "core/check.h"
 #include "core/point_kd_tree.h"
+#include "fusion/convex_hull.h"
 #include "fusion/marching_cubes.h"
 #include "fusion/surface_mesh.h"
 #include "fusion/triangle_cover.h"
@@ -157,89 +158,121 @@ std::vector<float> SignedDistance(const TriangleMesh& mesh, const Lattice& latti
   return distance;
 }
 
-}  // namespace
-
-ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& seen,
-                              const FreeSpace& free_space, double voxel_mm, double keep_seen_mm,
-                              double min_component_fraction) {
-  IHS_CHECK_ARG(voxel_mm > 0, "the bound's voxel must be positive, got " << voxel_mm);
-  ClosureBound result;
-  result.mesh = closed;
-  if (closed.faces.empty() || free_space.views() == 0) return result;
-  const float step = static_cast<float>(voxel_mm);
-  // Space seen empty inside the closed mesh is seen through its surface on the way there: when
-  // none of its vertices (away from the seen surface) lies deeper than a lattice step in empty
-  // space, nothing is cut (a step is what the lattice could place a cut to).
-  const PointKdTree seen_tree(seen.vertices);
-  const float keep_sq = static_cast<float>(keep_seen_mm * keep_seen_mm);
-  auto near_seen = [&](const Eigen::Vector3f& point) {
-    float distance_sq = 0;
-    return !seen.vertices.empty() && seen_tree.Nearest(point, &distance_sq) >= 0 &&
-           distance_sq < keep_sq;
-  };
-  const bool any_empty = std::any_of(closed.vertices.begin(), closed.vertices.end(),
-                                     [&](const Eigen::Vector3f& vertex) {
-                                       return free_space.Emptiness(vertex, 2 * step) > step &&
-                                              !near_seen(vertex);
-                                     });
-  if (!any_empty) return result;
-
-  // A lattice over the closed mesh with two steps of room on every side (all outside).
+// A lattice over `closed` with two steps of room on every side (all outside), of step `step`
+// or coarser for a closed mesh so large (a scene, not a held object) that the lattice would pass
+// kMaxLatticePoints (about 100 MB of lattice).
+Lattice LatticeAround(const TriangleMesh& closed, float step) {
   Eigen::Vector3f lo = closed.vertices[0], hi = closed.vertices[0];
   for (const auto& v : closed.vertices) {
     lo = lo.cwiseMin(v);
     hi = hi.cwiseMax(v);
   }
   Lattice lattice;
-  // A coarser step for a closed mesh so large (a scene, not a held object) that the lattice
-  // would pass kMaxLatticePoints (about 100 MB of lattice).
   const double box_volume = static_cast<double>((hi - lo).array().prod());
   lattice.step = std::max(step, static_cast<float>(std::cbrt(box_volume / kMaxLatticePoints)));
   lattice.origin = lo.array() - 2 * lattice.step;
   for (int axis = 0; axis < 3; ++axis) {
     lattice.size[axis] = static_cast<int>(std::ceil((hi[axis] - lo[axis]) / lattice.step)) + 5;
   }
-  // Distances beyond 1.5 steps never place a vertex; the emptiness is clamped alike.
-  const float band = 1.5f * lattice.step;
-  std::vector<float> field = SignedDistance(closed, lattice, band);
+  return lattice;
+}
 
-  // Points inside (or next to) the closed mesh that the views saw empty move outside, unless
-  // they are near the seen surface. Carved from the outside in: first the points next to the
-  // surface, then the inside neighbours of those found empty, and so on (space seen empty
-  // inside the mesh was seen through its surface; a deep inside that no empty path reaches is
-  // never evaluated, which keeps a large object's export fast).
-  std::vector<std::uint8_t> visited(field.size(), 0);
+// What says a point is outside the object: the views' emptiness and the seen surface's hull,
+// except near the seen surface.
+class Evidence {
+ public:
+  Evidence(const TriangleMesh& seen, const FreeSpace& free_space, const ConvexHull& hull,
+           double keep_seen_mm)
+      : seen_(seen),
+        tree_(seen.vertices),
+        free_space_(free_space),
+        hull_(hull),
+        keep_sq_(static_cast<float>(keep_seen_mm * keep_seen_mm)) {}
+
+  bool Any() const { return free_space_.views() > 0 || !hull_.Empty(); }
+  bool NearSeen(const Eigen::Vector3f& point) const {
+    float distance_sq = 0;
+    return !seen_.vertices.empty() && tree_.Nearest(point, &distance_sq) >= 0 &&
+           distance_sq < keep_sq_;
+  }
+  // How deep `point` lies in seen-empty space (−limit without views).
+  float Emptiness(const Eigen::Vector3f& point, float limit) const {
+    return free_space_.views() > 0 ? free_space_.Emptiness(point, limit) : -limit;
+  }
+  std::vector<float> Emptiness(const std::vector<Eigen::Vector3f>& points, float limit) const {
+    if (free_space_.views() == 0) return std::vector<float>(points.size(), -limit);
+    return free_space_.Emptiness(points, limit);
+  }
+  // How far `point` lies outside the hull (−limit without one).
+  float OutsideHull(const Eigen::Vector3f& point, float limit) const {
+    return hull_.Empty() ? -limit : hull_.SignedDistance(point, limit);
+  }
+
+ private:
+  const TriangleMesh& seen_;
+  const PointKdTree tree_;
+  const FreeSpace& free_space_;
+  const ConvexHull& hull_;
+  const float keep_sq_;
+};
+
+// What Carve cut: whether any point inside the closed mesh went, and how many of those went
+// for lying outside the hull (more than in empty space).
+struct Carving {
+  bool cut_inside = false;
+  std::int64_t hull_points = 0;
+};
+
+// Points inside (or next to) the closed mesh that the evidence puts outside move outside: the
+// field takes the evidence where larger. Carved from the outside in: first the points next to
+// the surface, then the inside neighbours of those found outside, and so on (space seen empty
+// inside the mesh was seen through its surface, and what lies outside a convex hull reaches
+// the closed mesh's surface; a deep inside that no such path reaches is never evaluated, which
+// keeps a large object's export fast).
+Carving Carve(const Lattice& lattice, const Evidence& evidence, float band,
+              std::vector<float>* field) {
+  std::vector<std::uint8_t> visited(field->size(), 0);
   std::vector<std::int64_t> frontier;
   for (std::int64_t n = 0; n < lattice.Count(); ++n) {
-    if (std::abs(field[n]) < band) {
+    if (std::abs((*field)[n]) < band) {
       frontier.push_back(n);
       visited[n] = 1;
     }
   }
-  bool cut_inside = false;
+  Carving carving;
   std::vector<Eigen::Vector3f> points;
   while (!frontier.empty()) {
     points.clear();
     for (const std::int64_t n : frontier) points.push_back(lattice.Point(n));
-    const std::vector<float> emptiness = free_space.Emptiness(points, band);
+    const std::vector<float> emptiness = evidence.Emptiness(points, band);
     std::vector<std::int64_t> next;
     for (size_t f = 0; f < frontier.size(); ++f) {
-      float& value = field[frontier[f]];
-      if (emptiness[f] <= value || near_seen(points[f])) continue;
-      if (value < 0 && emptiness[f] > 0) cut_inside = true;
-      value = emptiness[f];
-      if (emptiness[f] <= 0) continue;
+      float& value = (*field)[frontier[f]];
+      const float outside_hull = evidence.OutsideHull(points[f], band);
+      const float outside = std::max(emptiness[f], outside_hull);
+      if (outside <= value || evidence.NearSeen(points[f])) continue;
+      if (value < 0 && outside > 0) {
+        carving.cut_inside = true;
+        if (outside_hull > emptiness[f]) ++carving.hull_points;
+      }
+      value = outside;
+      if (outside <= 0) continue;
       for (const std::int64_t neighbour : lattice.Neighbours(frontier[f])) {
-        if (neighbour < 0 || visited[neighbour] || field[neighbour] >= band) continue;
+        if (neighbour < 0 || visited[neighbour] || (*field)[neighbour] >= band) continue;
         visited[neighbour] = 1;
         next.push_back(neighbour);
       }
     }
     frontier = std::move(next);
   }
-  if (!cut_inside) return result;
+  return carving;
+}
 
-  TriangleMesh bounded;
+// The zero set of `field` on `lattice` by marching cubes, without crumbs, with the colours of
+// the nearest vertex of `closed`.
+TriangleMesh Remesh(const Lattice& lattice, const std::vector<float>& field,
+                    const TriangleMesh& closed, double min_component_fraction) {
+  TriangleMesh mesh;
   auto value = [&](int i, int j, int k, float* sample) {
     *sample = field[lattice.Index(i, j, k)];
     return true;
@@ -247,22 +280,65 @@ ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& se
   auto add_vertex = [&](const LatticePoint& a, const LatticePoint& b, float s) {
     const Eigen::Vector3f pa = lattice.Point(a[0], a[1], a[2]);
     const Eigen::Vector3f pb = lattice.Point(b[0], b[1], b[2]);
-    bounded.vertices.push_back(pa + s * (pb - pa));
-    return static_cast<std::int32_t>(bounded.vertices.size() - 1);
+    mesh.vertices.push_back(pa + s * (pb - pa));
+    return static_cast<std::int32_t>(mesh.vertices.size() - 1);
   };
-  MarchingCubes(lattice.size, value, add_vertex, &bounded.faces);
-  bounded = RemoveSmallComponents(bounded, min_component_fraction);
-  bounded.ComputeVertexNormals();
-  if (closed.HasColors() && !bounded.Empty()) {
+  MarchingCubes(lattice.size, value, add_vertex, &mesh.faces);
+  mesh = RemoveSmallComponents(mesh, min_component_fraction);
+  mesh.ComputeVertexNormals();
+  if (closed.HasColors() && !mesh.Empty()) {
     const PointKdTree tree(closed.vertices);
-    bounded.colors.resize(bounded.vertices.size());
-    for (size_t n = 0; n < bounded.vertices.size(); ++n) {
+    mesh.colors.resize(mesh.vertices.size());
+    for (size_t n = 0; n < mesh.vertices.size(); ++n) {
       float distance_sq = 0;
-      bounded.colors[n] = closed.colors[tree.Nearest(bounded.vertices[n], &distance_sq)];
+      mesh.colors[n] = closed.colors[tree.Nearest(mesh.vertices[n], &distance_sq)];
     }
   }
+  return mesh;
+}
+
+}  // namespace
+
+ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
+                          const FreeSpace& free_space, const ClosureBoundOptions& options) {
+  IHS_CHECK_ARG(options.voxel_mm > 0,
+                "the bound's voxel must be positive, got " << options.voxel_mm);
+  ClosureBound result;
+  result.mesh = closed;
+  if (closed.faces.empty()) return result;
+  const float step = static_cast<float>(options.voxel_mm);
+  // Faces of the hull within a quarter step of coplanar merge: the lattice cannot place a cut
+  // finer, and a noisy surface's hull has a thousand faces rather than a hundred.
+  const ConvexHull hull =
+      options.seen_hull ? ConvexHull::Of(seen.vertices, 0.25 * step) : ConvexHull();
+  result.hull_planes = hull.planes();
+  const Evidence evidence(seen, free_space, hull, options.keep_seen_mm);
+  if (!evidence.Any()) return result;
+  // Space outside inside the closed mesh is reached through its surface: when none of its
+  // vertices (away from the seen surface) lies deeper than a lattice step in it, nothing is cut
+  // (a step is what the lattice could place a cut to).
+  const bool any_outside = std::any_of(
+      closed.vertices.begin(), closed.vertices.end(), [&](const Eigen::Vector3f& vertex) {
+        return std::max(evidence.Emptiness(vertex, 2 * step),
+                        evidence.OutsideHull(vertex, 2 * step)) > step &&
+               !evidence.NearSeen(vertex);
+      });
+  if (!any_outside) return result;
+
+  const Lattice lattice = LatticeAround(closed, step);
+  // Distances beyond 1.5 steps never place a vertex; the evidence is clamped alike.
+  const float band = 1.5f * lattice.step;
+  std::vector<float> field = SignedDistance(closed, lattice, band);
+  const Carving carving = Carve(lattice, evidence, band, &field);
+  if (!carving.cut_inside) return result;
+
+  TriangleMesh bounded = Remesh(lattice, field, closed, options.min_component_fraction);
   const double volume = closed.Volume();
-  result.removed_share = volume > 0 ? std::max(0.0, 1.0 - bounded.Volume() / volume) : 0.0;
+  if (volume > 0) {
+    result.removed_share = std::max(0.0, 1.0 - bounded.Volume() / volume);
+    result.hull_share =
+        std::min(result.removed_share, carving.hull_points * std::pow(lattice.step, 3.0) / volume);
+  }
   result.mesh = std::move(bounded);
   result.changed = true;
   return result;

@@ -1,33 +1,52 @@
 #pragma once
 // The closure cut back to the evidence: a closed mesh (Poisson's guess over what no frame saw)
-// without the space the camera saw through (free_space.h). Inside the result means inside the
-// closed mesh and not seen empty; the surface frames saw is never cut. The result is remeshed
-// by marching cubes over a lattice holding the larger of the closed mesh's signed distance and
-// the emptiness (the intersection of the two insides).
+// without the space the camera saw through (free_space.h) and, optionally, without what lies
+// beyond the convex hull of the surface frames saw (convex_hull.h: where no view looked, e.g.
+// under a bottle's base, Poisson bulges past the object and no ray saw that space empty).
+// Inside the result means inside the closed mesh, not seen empty and inside the seen surface's
+// hull; the surface frames saw is never cut. The result is remeshed by marching cubes over a
+// lattice holding the largest of the closed mesh's signed distance, the emptiness and the
+// hull's signed distance (the intersection of the insides).
 
 #include "core/triangle_mesh.h"
 #include "fusion/free_space.h"
 
 namespace ihs::fusion {
 
-/// What BoundByFreeSpace did.
+/// How BoundClosure cuts (MeshingOptions holds the user's choices).
+struct ClosureBoundOptions {
+  /// Lattice step, mm (coarser when the closed mesh is so large that the lattice would pass 16
+  /// million points: a scene rather than a held object).
+  double voxel_mm = 1.0;
+  /// Nothing within this distance (mm) of the seen surface's vertices is cut.
+  double keep_seen_mm = 2.0;
+  /// Also cut what lies outside the convex hull of the seen surface's vertices.
+  bool seen_hull = true;
+  /// Pieces with fewer faces than this share of the largest one's are dropped (a cut may leave
+  /// crumbs).
+  double min_component_fraction = 0.05;
+};
+
+/// What BoundClosure did.
 struct ClosureBound {
-  /// The bounded closed mesh: the input itself when nothing inside it was seen empty.
+  /// The bounded closed mesh: the input itself when nothing was cut.
   TriangleMesh mesh;
   /// Whether anything was cut.
   bool changed = false;
   /// Share of the closed mesh's volume that was cut (0 when unchanged).
   double removed_share = 0;
+  /// Share of the closed mesh's volume cut because it lay outside the seen surface's hull (more
+  /// than it lay in empty space; counted on the lattice).
+  double hull_share = 0;
+  /// Planes of the seen surface's hull (0: no hull: off, or a seen surface without volume).
+  int hull_planes = 0;
 };
 
-/// `closed` (watertight, object frame, mm) without the space `free_space` saw empty, except
-/// within `keep_seen_mm` of the vertices of `seen` (the surface frames saw), remeshed on a
-/// lattice of `voxel_mm` when anything is cut (coarser when the closed mesh is so large that
-/// the lattice would pass 16 million points: a scene rather than a held object); colours come from the nearest vertex of
-/// `closed`. Pieces with fewer faces than `min_component_fraction` of the largest one's are
-/// dropped (a cut may leave crumbs).
-ClosureBound BoundByFreeSpace(const TriangleMesh& closed, const TriangleMesh& seen,
-                              const FreeSpace& free_space, double voxel_mm, double keep_seen_mm,
-                              double min_component_fraction);
+/// `closed` (watertight, object frame, mm) without the space `free_space` saw empty and, with
+/// `options.seen_hull`, without what lies outside the convex hull of the vertices of `seen` (the
+/// surface frames saw), except within `options.keep_seen_mm` of those vertices; remeshed on the
+/// lattice when anything is cut. Colours come from the nearest vertex of `closed`.
+ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
+                          const FreeSpace& free_space, const ClosureBoundOptions& options);
 
 }  // namespace ihs::fusion

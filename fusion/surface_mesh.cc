@@ -309,13 +309,19 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
                            options.poisson_scale, options.color),
         options.min_component_fraction);
     result.poisson_ms = MillisecondsSince(start);
-    if (free_space != nullptr && free_space->views() > 0) {
+    const bool has_views = free_space != nullptr && free_space->views() > 0;
+    if (has_views || options.bound_by_seen_hull) {
       start = SteadyClock::now();
-      ClosureBound bound = BoundByFreeSpace(result.watertight, result.smoothed, *free_space,
-                                            options.bound_voxel_mm, options.bound_keep_seen_mm,
-                                            options.min_component_fraction);
+      ClosureBoundOptions bound_options;
+      bound_options.voxel_mm = options.bound_voxel_mm;
+      bound_options.keep_seen_mm = options.bound_keep_seen_mm;
+      bound_options.seen_hull = options.bound_by_seen_hull;
+      bound_options.min_component_fraction = options.min_component_fraction;
+      ClosureBound bound = BoundClosure(result.watertight, result.smoothed,
+                                        has_views ? *free_space : FreeSpace(), bound_options);
       result.watertight = std::move(bound.mesh);
       result.cut_share = bound.removed_share;
+      result.hull_cut_share = bound.hull_share;
       result.bound_ms = MillisecondsSince(start);
     }
     result.unseen_share = UnseenShare(result.watertight, result.smoothed);

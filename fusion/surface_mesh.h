@@ -36,9 +36,14 @@ struct MeshingOptions {
   /// The closed mesh is cut back to the space no view saw empty (closure_bound.h), remeshed on
   /// a lattice of this step (mm; about the TSDF's 1.37 mm voxel, finer than Poisson's detail
   /// on a hand-held object); within `bound_keep_seen_mm` of the seen surface nothing is cut.
-  /// Off when MakeMeshes gets no views.
+  /// The views' part is off when MakeMeshes gets none.
   double bound_voxel_mm = 1.0;
   double bound_keep_seen_mm = 2.0;
+  /// The closed mesh is also cut to the convex hull of the seen surface's vertices (a bottle's
+  /// unseen base ends flat at the lowest seen ring instead of Poisson's bulge, which no view saw
+  /// empty; a convex object's closure never passes the object; a concave one's seen surface is
+  /// inside its own hull and stays). Costs a half-seen ball its unseen cap. Works without views.
+  bool bound_by_seen_hull = true;
   /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).
   bool color = true;
 
@@ -78,8 +83,10 @@ struct MeshingResult {
   /// Share of `watertight`'s surface farther than 2 mm from `smoothed`: what no frame saw and
   /// Poisson made up (UnseenShare); its volume is a guess over that part. 0 without `watertight`.
   double unseen_share = 0;
-  /// Share of Poisson's volume cut because views saw that space empty (0: nothing cut).
+  /// Share of Poisson's volume cut because views saw that space empty or it lay outside the
+  /// seen surface's hull (0: nothing cut), and of it the hull's part.
   double cut_share = 0;
+  double hull_cut_share = 0;
   /// Pairs of `watertight`'s faces that cross (FindSelfIntersections): Poisson can fold its
   /// surface through itself, and such a mesh is closed and manifold but not watertight.
   std::int64_t self_intersections = 0;
@@ -92,8 +99,8 @@ struct MeshingResult {
   double bound_ms = 0;
 };
 
-/// Runs the steps above on a raw marching-cubes mesh; with `free_space`, Poisson's mesh is
-/// bounded by its views.
+/// Runs the steps above on a raw marching-cubes mesh; Poisson's mesh is bounded by the views of
+/// `free_space` (when given) and by the seen surface's hull (`bound_by_seen_hull`).
 MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options = {},
                          const FreeSpace* free_space = nullptr);
 

@@ -43,6 +43,32 @@ TriangleMesh MakeUvSphere(float radius_mm, int rings, int segments, const Eigen:
   return mesh;
 }
 
+TriangleMesh MakeLathe(const std::vector<std::pair<float, float>>& profile, int segments) {
+  TriangleMesh mesh;
+  std::vector<int> first;  // Each ring's first vertex; a pole has one.
+  for (const auto& [z, radius] : profile) {
+    first.push_back(static_cast<int>(mesh.vertices.size()));
+    const int count = radius > 0 ? segments : 1;
+    for (int s = 0; s < count; ++s) {
+      const double phi = 2 * M_PI * s / segments;
+      mesh.vertices.emplace_back(radius * std::cos(phi), radius * std::sin(phi), z);
+    }
+  }
+  auto vertex = [&](size_t ring, int s) {
+    return profile[ring].second > 0 ? first[ring] + s % segments : first[ring];
+  };
+  for (size_t ring = 0; ring + 1 < profile.size(); ++ring) {
+    for (int s = 0; s < segments; ++s) {
+      // Counter-clockwise about z from below to above: outward.
+      const int a0 = vertex(ring, s), a1 = vertex(ring, s + 1);
+      const int b0 = vertex(ring + 1, s), b1 = vertex(ring + 1, s + 1);
+      if (a0 != a1) mesh.faces.push_back({a0, a1, b0});
+      if (b0 != b1) mesh.faces.push_back({a1, b1, b0});
+    }
+  }
+  return mesh;
+}
+
 TriangleMesh MergeMeshes(TriangleMesh a, const TriangleMesh& b, const Eigen::Vector3f& shift) {
   const auto offset = static_cast<std::int32_t>(a.vertices.size());
   for (const Eigen::Vector3f& v : b.vertices) a.vertices.push_back(v + shift);

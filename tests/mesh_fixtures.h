@@ -1,6 +1,9 @@
 #pragma once
 // Small closed meshes with known geometry for tests.
 
+#include <utility>
+#include <vector>
+
 #include "core/triangle_mesh.h"
 
 namespace ihs::test {
@@ -12,6 +15,11 @@ TriangleMesh MakeCube(float edge_mm);
 /// `segments` longitudes, outward faces, unit normals.
 TriangleMesh MakeUvSphere(float radius_mm, int rings, int segments,
                           const Eigen::Vector3f& center = Eigen::Vector3f::Zero());
+
+/// A surface of revolution about z through the (z, radius) pairs of `profile`, from the bottom
+/// up, with `segments` longitudes and outward faces: a pair of radius 0 is a pole; open where
+/// an end's radius is not 0 (closed when both ends are poles).
+TriangleMesh MakeLathe(const std::vector<std::pair<float, float>>& profile, int segments);
 
 /// `a` and `b` moved by `shift` as one mesh of two parts (without normals).
 TriangleMesh MergeMeshes(TriangleMesh a, const TriangleMesh& b, const Eigen::Vector3f& shift);

@@ -116,6 +116,7 @@ nlohmann::json MeshSummary(const ihs::fusion::MeshingResult& meshes, double expo
             {"self_intersections", meshes.self_intersections},
             {"unseen_share", meshes.unseen_share},
             {"cut_share", meshes.cut_share},
+            {"hull_cut_share", meshes.hull_cut_share},
             {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
 }
 
@@ -154,8 +155,11 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
               "watertight mesh never seen\n",
               100 * record.coverage(), 100 * meshes.unseen_share);
   if (meshes.cut_share > 0) {
-    std::printf("closure: %.1f %% of Poisson's volume cut away where the views saw empty space\n",
-                100 * meshes.cut_share);
+    std::printf(
+        "closure: %.1f %% of Poisson's volume cut away where the views saw empty space "
+        "(%.1f %%) or beyond the seen surface's convex hull (%.1f %%)\n",
+        100 * meshes.cut_share, 100 * (meshes.cut_share - meshes.hull_cut_share),
+        100 * meshes.hull_cut_share);
   }
 }
 

@@ -1,5 +1,6 @@
 // A closure that balloons past what the views saw is cut back to the space they did not see
-// empty; one that stays inside it is left as it is.
+// empty, and one that bulges past the seen surface's convex hull back to the hull; one that
+// stays inside both is left as it is.
 
 #include "fusion/closure_bound.h"
 
@@ -7,8 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "core/mesh_intersections.h"
+#include "fusion/convex_hull.h"
 #include "tests/free_space_fixtures.h"
 #include "tests/mesh_fixtures.h"
 
@@ -16,6 +20,14 @@ namespace ihs::fusion {
 namespace {
 
 using test::kCubeEdgeMm;
+
+// The views' evidence alone (the hull off), keeping `keep_seen_mm` around the seen surface.
+ClosureBoundOptions FreeSpaceOnly(double keep_seen_mm = 2.0) {
+  ClosureBoundOptions options;
+  options.keep_seen_mm = keep_seen_mm;
+  options.seen_hull = false;
+  return options;
+}
 
 // Views of the cube from a ring of directions about y, 30° apart, and from above and below.
 FreeSpace RingOfViews() {
@@ -42,7 +54,7 @@ TEST(ClosureBoundTest, ABalloonThroughSpaceTheViewsSawEmptyIsCutBackToIt) {
   // Poisson's guess: a ball round the cube, 15 % past its corners, 4.2 times its volume.
   const TriangleMesh balloon = test::MakeUvSphere(kCubeEdgeMm, 32, 64);
   const TriangleMesh seen = test::MakeCube(kCubeEdgeMm);
-  const ClosureBound bound = BoundByFreeSpace(balloon, seen, free_space, 1.0, 2.0, 0.05);
+  const ClosureBound bound = BoundClosure(balloon, seen, free_space, FreeSpaceOnly());
   ASSERT_TRUE(bound.changed);
   const TriangleMesh& mesh = bound.mesh;
   EXPECT_TRUE(mesh.IsWatertight());
@@ -76,7 +88,7 @@ TEST(ClosureBoundTest, ABalloonThroughSpaceTheViewsSawEmptyIsCutBackToIt) {
   // Colours of the closed mesh carried over.
   TriangleMesh coloured = balloon;
   coloured.colors.assign(coloured.vertices.size(), {10, 200, 30});
-  const ClosureBound with_colour = BoundByFreeSpace(coloured, seen, free_space, 1.0, 2.0, 0.05);
+  const ClosureBound with_colour = BoundClosure(coloured, seen, free_space, FreeSpaceOnly());
   ASSERT_TRUE(with_colour.mesh.HasColors());
   EXPECT_EQ(with_colour.mesh.colors.front(), (TriangleMesh::Color{10, 200, 30}));
 }
@@ -88,7 +100,7 @@ TEST(ClosureBoundTest, TheSeenSurfaceIsNeverCut) {
   const TriangleMesh big = test::MakeCube(kCubeEdgeMm + 30);
   const float radius = kCubeEdgeMm / 2 + 10;
   const TriangleMesh seen = test::MakeUvSphere(radius, 48, 96);
-  const ClosureBound kept = BoundByFreeSpace(big, seen, free_space, 1.0, 3.0, 0.05);
+  const ClosureBound kept = BoundClosure(big, seen, free_space, FreeSpaceOnly(3.0));
   ASSERT_TRUE(kept.changed);
   Eigen::Vector3f reach = Eigen::Vector3f::Zero();
   for (const auto& v : kept.mesh.vertices) reach = reach.cwiseMax(v.cwiseAbs());
@@ -102,11 +114,116 @@ TEST(ClosureBoundTest, AClosureInsideWhatWasNotSeenEmptyIsLeftAsItIs) {
   const FreeSpace free_space = RingOfViews();
   const TriangleMesh inside = test::MakeUvSphere(kCubeEdgeMm * 0.45f, 16, 32);
   const TriangleMesh seen = test::MakeCube(kCubeEdgeMm);
-  const ClosureBound bound = BoundByFreeSpace(inside, seen, free_space, 1.0, 2.0, 0.05);
+  const ClosureBound bound = BoundClosure(inside, seen, free_space, {});
   EXPECT_FALSE(bound.changed);
   EXPECT_EQ(bound.removed_share, 0);
   EXPECT_EQ(bound.mesh.vertices, inside.vertices);
-  EXPECT_FALSE(BoundByFreeSpace(inside, seen, FreeSpace(), 1.0, 2.0, 0.05).changed);
+  EXPECT_FALSE(BoundClosure(inside, seen, FreeSpace(), {}).changed);
+}
+
+// The profile of a body of revolution about z from z = 0 to `height` (radius `radius(z)`, 1 mm
+// apart), with a bulge of `bulge_mm` past each end (an ellipsoidal cap: Poisson's guess over an
+// unseen base) when `bulge_mm` > 0; open at both ends otherwise.
+template <typename Radius>
+std::vector<std::pair<float, float>> Profile(float height, Radius radius, float bulge_mm) {
+  std::vector<std::pair<float, float>> profile;
+  auto cap = [&](float end, float sign) {
+    for (int step = 10; step > 0; --step) {
+      const float t = step / 10.0f;  // 1 at the pole, 0 at the rim.
+      profile.emplace_back(end + sign * bulge_mm * t, radius(end) * std::sqrt(1 - t * t));
+    }
+  };
+  if (bulge_mm > 0) cap(0, -1);
+  for (int z = 0; z <= static_cast<int>(height); ++z) {
+    profile.emplace_back(static_cast<float>(z), radius(static_cast<float>(z)));
+  }
+  if (bulge_mm > 0) {
+    const size_t top = profile.size();
+    cap(height, 1);
+    std::reverse(profile.begin() + top, profile.end());
+  }
+  return profile;
+}
+
+TEST(ClosureBoundTest, ABulgePastTheSeenRimIsCutFlatAtTheRimsPlane) {
+  // A bottle's side seen, its base and top never: Poisson bulged 15 mm past both rims, where no
+  // view looked (no views here at all).
+  auto cylinder = [](float) { return 30.0f; };
+  const TriangleMesh seen = test::MakeLathe(Profile(80, cylinder, 0), 64);
+  const TriangleMesh bulging = test::MakeLathe(Profile(80, cylinder, 15), 64);
+  ASSERT_TRUE(bulging.IsWatertight());
+  const ClosureBound bound = BoundClosure(bulging, seen, FreeSpace(), {});
+  ASSERT_TRUE(bound.changed);
+  const TriangleMesh& mesh = bound.mesh;
+  EXPECT_TRUE(mesh.IsWatertight());
+  EXPECT_EQ(FindSelfIntersections(mesh, 0).pairs, 0);
+  EXPECT_GE(bound.hull_planes, 4);
+  // Flat at the rims' planes: away from the rims (where `keep_seen_mm` keeps 2 mm of the
+  // bulge) within 1.5 mm of them, and nowhere past them by more than the kept 2 mm and a step.
+  int on_caps = 0;
+  for (const auto& v : mesh.vertices) {
+    ASSERT_GT(v.z(), -3.0f) << v.transpose();
+    ASSERT_LT(v.z(), 83.0f) << v.transpose();
+    if (v.head<2>().norm() > 26) continue;
+    ++on_caps;
+    ASSERT_LT(std::min(std::abs(v.z()), std::abs(v.z() - 80)), 1.5f) << v.transpose();
+  }
+  EXPECT_GT(on_caps, 1000);
+  // The cylinder's volume (the 64-gon's), within what the 1 mm lattice and the kept rims give.
+  const double cylinder_volume = 0.5 * 64 * 30 * 30 * std::sin(2 * M_PI / 64) * 80;
+  EXPECT_NEAR(mesh.Volume(), cylinder_volume, 0.02 * cylinder_volume);
+  EXPECT_NEAR(bound.removed_share, 1 - mesh.Volume() / bulging.Volume(), 1e-9);
+  EXPECT_NEAR(bound.hull_share, bound.removed_share, 0.03);
+
+  // Off: no views, no hull, nothing cut; the bulge stays.
+  ClosureBoundOptions off;
+  off.seen_hull = false;
+  const ClosureBound kept = BoundClosure(bulging, seen, FreeSpace(), off);
+  EXPECT_FALSE(kept.changed);
+  EXPECT_EQ(kept.hull_planes, 0);
+  EXPECT_EQ(kept.mesh.vertices, bulging.vertices);
+}
+
+TEST(ClosureBoundTest, AConcaveSeenSurfaceIsInsideItsHullAndStays) {
+  // A bowling pin's neck, seen all round: 30 mm wide at the ends, 18 mm at the waist. The
+  // closure over its unseen ends bulges and is cut; the neck, inside the hull, is not.
+  auto neck = [](float z) { return 30.0f - 12.0f * static_cast<float>(std::sin(M_PI * z / 80)); };
+  const TriangleMesh seen = test::MakeLathe(Profile(80, neck, 0), 64);
+  const TriangleMesh bulging = test::MakeLathe(Profile(80, neck, 15), 64);
+  const ClosureBound bound = BoundClosure(bulging, seen, FreeSpace(), {});
+  ASSERT_TRUE(bound.changed);
+  EXPECT_TRUE(bound.mesh.IsWatertight());
+  float lowest = 0;
+  for (const auto& v : bound.mesh.vertices) {
+    lowest = std::min(lowest, v.z());
+    if (v.z() < 10 || v.z() > 70) continue;
+    // On the seen surface within the lattice's rounding (and the 64-gon's chords).
+    ASSERT_NEAR(v.head<2>().norm(), neck(v.z()), 0.6f) << v.transpose();
+  }
+  EXPECT_GT(lowest, -3.0f);
+
+  // A closure that is the seen surface with flat ends (nothing past the hull) is left as it is.
+  std::vector<std::pair<float, float>> flat = Profile(80, neck, 0);
+  flat.insert(flat.begin(), {0.0f, 0.0f});
+  flat.emplace_back(80.0f, 0.0f);
+  const TriangleMesh closed = test::MakeLathe(flat, 64);
+  ASSERT_TRUE(closed.IsWatertight());
+  const ClosureBound unchanged = BoundClosure(closed, seen, FreeSpace(), {});
+  EXPECT_FALSE(unchanged.changed);
+  EXPECT_EQ(unchanged.mesh.vertices, closed.vertices);
+}
+
+TEST(ClosureBoundTest, ASeenSurfaceWithoutVolumeHasNoHull) {
+  // A flat patch (one face of a box seen head on) spans no volume: no hull, nothing cut.
+  TriangleMesh patch;
+  patch.vertices = {{0, 0, 0}, {40, 0, 0}, {40, 40, 0}, {0, 40, 0}};
+  patch.faces = {{0, 1, 2}, {0, 2, 3}};
+  const TriangleMesh ball = test::MakeUvSphere(30, 16, 32, {20, 20, 0});
+  const ClosureBound bound = BoundClosure(ball, patch, FreeSpace(), {});
+  EXPECT_EQ(bound.hull_planes, 0);
+  EXPECT_FALSE(bound.changed);
+  EXPECT_TRUE(ConvexHull::Of(patch.vertices, 0.25).Empty());
+  EXPECT_TRUE(ConvexHull::Of({}, 0.25).Empty());
 }
 
 }  // namespace

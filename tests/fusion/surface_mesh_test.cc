@@ -124,9 +124,11 @@ TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
   }
   EXPECT_GT(near, 0.98 * counted);
 
-  // The export says how much of its watertight mesh is made up: the cap beyond the seen rim (the
-  // smoothed surface's highest point, a little below 25 mm) less the 2 mm band along it.
-  const MeshingResult meshes = MakeMeshes(open);
+  // The export says how much of its watertight mesh is made up: Poisson's cap beyond the seen rim
+  // (the smoothed surface's highest point, a little below 25 mm) less the 2 mm band along it.
+  MeshingOptions poisson_cap;
+  poisson_cap.bound_by_seen_hull = false;
+  const MeshingResult meshes = MakeMeshes(open, poisson_cap);
   ASSERT_TRUE(meshes.watertight.IsWatertight());
   float rim_z = -35;
   for (const auto& v : meshes.smoothed.vertices) rim_z = std::max(rim_z, v.z());
@@ -136,6 +138,17 @@ TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
   // sphere's area is (1 - cos θ) / 2.
   const double band_end = std::acos(rim_z / 35.0) - 2.0 / 35;
   EXPECT_NEAR(meshes.unseen_share, (1 - std::cos(band_end)) / 2, 0.01);
+  EXPECT_EQ(meshes.cut_share, 0);
+
+  // By default the cap is cut flat at the rim's plane (the seen surface's convex hull), but for
+  // the 2 mm kept along the rim.
+  const MeshingResult flat = MakeMeshes(open);
+  ASSERT_TRUE(flat.IsWatertight());
+  float top = -35;
+  for (const auto& v : flat.watertight.vertices) top = std::max(top, v.z());
+  EXPECT_LT(top, rim_z + 2.5f);
+  EXPECT_GT(flat.cut_share, 0.01);
+  EXPECT_NEAR(flat.hull_cut_share, flat.cut_share, 0.01);
 }
 
 TEST(SurfaceMeshTest, ATsdfSphereGivesAWatertightMeshOfItsSize) {
