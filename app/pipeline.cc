@@ -432,6 +432,7 @@ void Pipeline::ExportLoop() {
                                 {"unseen_share", exported.meshes.unseen_share},
                                 {"cut_share", exported.meshes.cut_share},
                                 {"hull_cut_share", exported.meshes.hull_cut_share},
+                                {"hull_revolved", exported.meshes.hull_revolved},
                                 {"volume_mm3", exported.meshes.watertight.IsWatertight()
                                                    ? exported.meshes.watertight.Volume()
                                                    : 0.0}}}};

@@ -290,6 +290,9 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
   r.Add("mesh.bound_by_seen_hull", &m.bound_by_seen_hull,
         "also cut the closed mesh to the convex hull of the seen surface (a bottle's unseen base "
         "ends flat at the lowest seen ring)");
+  r.Add("mesh.bound_revolve_max_residual", &m.bound_revolve_max_residual,
+        "a seen surface whose sections fit circles within this share of their radius is turned "
+        "all round its axis before its hull is taken (its unseen round side is not cut; 0: never)");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
 }
 

@@ -10,6 +10,7 @@
 #include "core/point_kd_tree.h"
 #include "fusion/convex_hull.h"
 #include "fusion/marching_cubes.h"
+#include "fusion/measure.h"
 #include "fusion/surface_mesh.h"
 #include "fusion/triangle_cover.h"
 
@@ -177,8 +178,8 @@ Lattice LatticeAround(const TriangleMesh& closed, float step) {
   return lattice;
 }
 
-// What says a point is outside the object: the views' emptiness and the seen surface's hull,
-// except near the seen surface.
+// What says a point is outside the object: the views' emptiness (except near the seen surface)
+// and the seen surface's hull.
 class Evidence {
  public:
   Evidence(const TriangleMesh& seen, const FreeSpace& free_space, const ConvexHull& hull,
@@ -190,11 +191,6 @@ class Evidence {
         keep_sq_(static_cast<float>(keep_seen_mm * keep_seen_mm)) {}
 
   bool Any() const { return free_space_.views() > 0 || !hull_.Empty(); }
-  bool NearSeen(const Eigen::Vector3f& point) const {
-    float distance_sq = 0;
-    return !seen_.vertices.empty() && tree_.Nearest(point, &distance_sq) >= 0 &&
-           distance_sq < keep_sq_;
-  }
   // How deep `point` lies in seen-empty space (−limit without views).
   float Emptiness(const Eigen::Vector3f& point, float limit) const {
     return free_space_.views() > 0 ? free_space_.Emptiness(point, limit) : -limit;
@@ -203,12 +199,24 @@ class Evidence {
     if (free_space_.views() == 0) return std::vector<float>(points.size(), -limit);
     return free_space_.Emptiness(points, limit);
   }
-  // How far `point` lies outside the hull (−limit without one).
-  float OutsideHull(const Eigen::Vector3f& point, float limit) const {
-    return hull_.Empty() ? -limit : hull_.SignedDistance(point, limit);
+  // How far `point` lies outside the object by the evidence, clamped to `limit`: the larger of
+  // its distance outside the hull (`by_hull`) and `emptiness` (read off the views), which counts
+  // only where it passes `floor` and not near the seen surface (a misregistered view may have
+  // seen through it; the seen surface lies inside its hull, which needs no such care).
+  float Outside(const Eigen::Vector3f& point, float emptiness, float floor, float limit,
+                bool* by_hull) const {
+    const float outside_hull = hull_.Empty() ? -limit : hull_.SignedDistance(point, limit);
+    *by_hull = !(emptiness > std::max(outside_hull, floor) && !NearSeen(point));
+    return *by_hull ? outside_hull : emptiness;
   }
 
  private:
+  bool NearSeen(const Eigen::Vector3f& point) const {
+    float distance_sq = 0;
+    return !seen_.vertices.empty() && tree_.Nearest(point, &distance_sq) >= 0 &&
+           distance_sq < keep_sq_;
+  }
+
   const TriangleMesh& seen_;
   const PointKdTree tree_;
   const FreeSpace& free_space_;
@@ -248,12 +256,12 @@ Carving Carve(const Lattice& lattice, const Evidence& evidence, float band,
     std::vector<std::int64_t> next;
     for (size_t f = 0; f < frontier.size(); ++f) {
       float& value = (*field)[frontier[f]];
-      const float outside_hull = evidence.OutsideHull(points[f], band);
-      const float outside = std::max(emptiness[f], outside_hull);
-      if (outside <= value || evidence.NearSeen(points[f])) continue;
+      bool by_hull = false;
+      const float outside = evidence.Outside(points[f], emptiness[f], value, band, &by_hull);
+      if (outside <= value) continue;
       if (value < 0 && outside > 0) {
         carving.cut_inside = true;
-        if (outside_hull > emptiness[f]) ++carving.hull_points;
+        if (by_hull) ++carving.hull_points;
       }
       value = outside;
       if (outside <= 0) continue;
@@ -297,6 +305,22 @@ TriangleMesh Remesh(const Lattice& lattice, const std::vector<float>& field,
   return mesh;
 }
 
+// The convex hull of `seen`'s vertices, or of their revolution about its axis when `seen` is a
+// body of revolution (`revolved` says which); faces within `merge_mm` of coplanar merged. A seen
+// surface without volume (flat) has no hull, revolved or not.
+ConvexHull SeenHull(const TriangleMesh& seen, double max_residual, double merge_mm,
+                    bool* revolved) {
+  *revolved = false;
+  ConvexHull hull = ConvexHull::Of(seen.vertices, merge_mm);
+  if (hull.Empty() || max_residual <= 0) return hull;
+  const RevolutionMeasures round = MeasureRevolution(seen);
+  // At least a few sections: the axis is a line through their centres.
+  if (round.roundness_residual > max_residual || round.profile.size() < 3) return hull;
+  *revolved = true;
+  return ConvexHull::Of(RevolvedEnvelope(seen.vertices, round.axis_point, round.axis, 2.0, 64),
+                        merge_mm);
+}
+
 }  // namespace
 
 ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
@@ -309,8 +333,9 @@ ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
   const float step = static_cast<float>(options.voxel_mm);
   // Faces of the hull within a quarter step of coplanar merge: the lattice cannot place a cut
   // finer, and a noisy surface's hull has a thousand faces rather than a hundred.
-  const ConvexHull hull =
-      options.seen_hull ? ConvexHull::Of(seen.vertices, 0.25 * step) : ConvexHull();
+  const ConvexHull hull = options.seen_hull ? SeenHull(seen, options.revolve_max_residual,
+                                                       0.25 * step, &result.hull_revolved)
+                                            : ConvexHull();
   result.hull_planes = hull.planes();
   const Evidence evidence(seen, free_space, hull, options.keep_seen_mm);
   if (!evidence.Any()) return result;
@@ -319,9 +344,9 @@ ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
   // (a step is what the lattice could place a cut to).
   const bool any_outside = std::any_of(
       closed.vertices.begin(), closed.vertices.end(), [&](const Eigen::Vector3f& vertex) {
-        return std::max(evidence.Emptiness(vertex, 2 * step),
-                        evidence.OutsideHull(vertex, 2 * step)) > step &&
-               !evidence.NearSeen(vertex);
+        bool by_hull = false;
+        const float emptiness = evidence.Emptiness(vertex, 2 * step);
+        return evidence.Outside(vertex, emptiness, step, 2 * step, &by_hull) > step;
       });
   if (!any_outside) return result;
 

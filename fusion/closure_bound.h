@@ -18,10 +18,16 @@ struct ClosureBoundOptions {
   /// Lattice step, mm (coarser when the closed mesh is so large that the lattice would pass 16
   /// million points: a scene rather than a held object).
   double voxel_mm = 1.0;
-  /// Nothing within this distance (mm) of the seen surface's vertices is cut.
+  /// Nothing within this distance (mm) of the seen surface's vertices is cut for the views'
+  /// emptiness (misregistered views may have seen through it).
   double keep_seen_mm = 2.0;
   /// Also cut what lies outside the convex hull of the seen surface's vertices.
   bool seen_hull = true;
+  /// When the seen surface is a body of revolution (MeasureRevolution: its sections fit circles
+  /// within this share of their radius, RMS), the hull is that of the surface turned all round
+  /// its axis (RevolvedEnvelope): what was not seen of its round side is not cut, only its
+  /// unseen ends (0: never).
+  double revolve_max_residual = 0.03;
   /// Pieces with fewer faces than this share of the largest one's are dropped (a cut may leave
   /// crumbs).
   double min_component_fraction = 0.05;
@@ -40,12 +46,15 @@ struct ClosureBound {
   double hull_share = 0;
   /// Planes of the seen surface's hull (0: no hull: off, or a seen surface without volume).
   int hull_planes = 0;
+  /// Whether the hull was that of the seen surface's revolution about its axis.
+  bool hull_revolved = false;
 };
 
-/// `closed` (watertight, object frame, mm) without the space `free_space` saw empty and, with
-/// `options.seen_hull`, without what lies outside the convex hull of the vertices of `seen` (the
-/// surface frames saw), except within `options.keep_seen_mm` of those vertices; remeshed on the
-/// lattice when anything is cut. Colours come from the nearest vertex of `closed`.
+/// `closed` (watertight, object frame, mm) without the space `free_space` saw empty, except
+/// within `options.keep_seen_mm` of the vertices of `seen` (the surface frames saw), and, with
+/// `options.seen_hull`, without what lies outside the convex hull of those vertices (or of their
+/// revolution; `seen` lies inside it and is never cut); remeshed on the lattice when anything is
+/// cut. Colours come from the nearest vertex of `closed`.
 ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
                           const FreeSpace& free_space, const ClosureBoundOptions& options);
 

@@ -1,6 +1,8 @@
 #include "fusion/convex_hull.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -82,6 +84,48 @@ float ConvexHull::SignedDistance(const Eigen::Vector3f& point, float limit) cons
     if (distance >= limit) return limit;
   }
   return distance;
+}
+
+std::vector<Eigen::Vector3f> RevolvedEnvelope(const std::vector<Eigen::Vector3f>& points,
+                                              const Eigen::Vector3d& centre,
+                                              const Eigen::Vector3d& axis, double slice_mm,
+                                              int segments) {
+  std::vector<Eigen::Vector3f> envelope;
+  if (points.empty()) return envelope;
+  // Per slice: the lowest and highest height along the axis and the largest distance from it.
+  struct Slice {
+    double low = INFINITY, high = -INFINITY, reach = 0;
+  };
+  std::vector<double> height(points.size());
+  double lowest = INFINITY;
+  for (size_t n = 0; n < points.size(); ++n) {
+    height[n] = (points[n].cast<double>() - centre).dot(axis);
+    lowest = std::min(lowest, height[n]);
+  }
+  std::vector<Slice> slices;
+  for (size_t n = 0; n < points.size(); ++n) {
+    const auto s = static_cast<size_t>((height[n] - lowest) / slice_mm);
+    if (s >= slices.size()) slices.resize(s + 1);
+    const Eigen::Vector3d off = points[n].cast<double>() - centre - height[n] * axis;
+    slices[s].low = std::min(slices[s].low, height[n]);
+    slices[s].high = std::max(slices[s].high, height[n]);
+    slices[s].reach = std::max(slices[s].reach, off.norm());
+  }
+  // A polygon circumscribed about the circle of radius `reach`.
+  const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
+  for (const Slice& slice : slices) {
+    if (slice.high < slice.low) continue;  // No point in this slice.
+    const double radius = slice.reach / std::cos(M_PI / segments);
+    for (const double h : {slice.low, slice.high}) {
+      for (int k = 0; k < segments; ++k) {
+        const double angle = 2 * M_PI * k / segments;
+        envelope.push_back(
+            (centre + h * axis + radius * (std::cos(angle) * u + std::sin(angle) * v))
+                .cast<float>());
+      }
+    }
+  }
+  return envelope;
 }
 
 }  // namespace ihs::fusion

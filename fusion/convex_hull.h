@@ -32,4 +32,13 @@ class ConvexHull {
   std::vector<Eigen::Vector4f> planes_;
 };
 
+/// Points whose convex hull holds every one of `points` turned about the axis through `centre`
+/// along `axis` (unit), by any angle: per `slice_mm` along the axis, two circumscribed
+/// `segments`-gons, at the slice's lowest and highest point, as wide as its point farthest from
+/// the axis. The hull of a body of revolution seen from one side, completed all round.
+std::vector<Eigen::Vector3f> RevolvedEnvelope(const std::vector<Eigen::Vector3f>& points,
+                                              const Eigen::Vector3d& centre,
+                                              const Eigen::Vector3d& axis, double slice_mm,
+                                              int segments);
+
 }  // namespace ihs::fusion

@@ -67,6 +67,7 @@ static RevolutionMeasures MeasureAlong(
   RevolutionMeasures result;
   result.axis = axis;
   result.centre = centre;
+  result.axis_point = centre;
   // Extent along the axis.
   double low = INFINITY, high = -INFINITY;
   for (const auto& v : mesh.vertices) {
@@ -138,20 +139,23 @@ static RevolutionMeasures MeasureAlong(
   *residual = weight_sum > 0 && radius_sum > 0
                   ? std::sqrt(misfit / weight_sum) / (radius_sum / weight_sum)
                   : INFINITY;
+  result.roundness_residual = *residual;
   // Bins with little surface (an end, a gap) are noise: they need a tenth of the typical bin's.
   std::vector<double> sorted = weight;
   std::sort(sorted.begin(), sorted.end());
   const double min_weight = 0.1 * sorted[sorted.size() / 2];
+  Eigen::Vector3d centre_sum = Eigen::Vector3d::Zero();
+  double centre_weight = 0;
   for (int b = 0; b < bins; ++b) {
     if (weight[b] <= 0 || weight[b] < min_weight || radius[b] <= 0) continue;
     result.profile.push_back({(b + 0.5) * slice_mm, 2 * radius[b]});
-    if (circle_centres) {
-      circle_centres->push_back({centre + (low + (b + 0.5) * slice_mm) * result.axis +
-                                     circle_centre[b].x() * across_u +
-                                     circle_centre[b].y() * across_v,
-                                 weight[b]});
-    }
+    const Eigen::Vector3d section_centre = centre + (low + (b + 0.5) * slice_mm) * result.axis +
+                                           circle_centre[b].x() * across_u +
+                                           circle_centre[b].y() * across_v;
+    centre_sum += weight[b] * section_centre, centre_weight += weight[b];
+    if (circle_centres) circle_centres->push_back({section_centre, weight[b]});
   }
+  if (centre_weight > 0) result.axis_point = centre_sum / centre_weight;
   if (result.profile.empty()) return result;
 
   // Widest section; then, toward the farther end, the narrowest and the widest beyond it.

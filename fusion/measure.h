@@ -5,6 +5,7 @@
 // given the true surface, how far the scan is from it (Chamfer distance, completeness).
 
 #include <Eigen/Core>
+#include <cmath>
 #include <utility>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct RevolutionMeasures {
   /// A point on the symmetry axis (the surface's centroid) and the axis's direction, mm.
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  /// A point on the symmetry axis: the sections' circle centres' mean (on a surface seen from one
+  /// side `centre` lies off the axis, toward the side seen), mm.
+  Eigen::Vector3d axis_point = Eigen::Vector3d::Zero();
   /// Extent along the axis, mm.
   double height_mm = 0;
   /// Diameter of the widest section, and where it is (height above the lower end), mm.
@@ -28,6 +32,9 @@ struct RevolutionMeasures {
   double head_diameter_mm = 0;
   /// Section diameters along the axis: (height above the lower end, diameter), mm.
   std::vector<std::pair<double, double>> profile;
+  /// How far the side vertices are from their sections' circles: weighted RMS over the mean
+  /// radius (0 for a body of revolution; a box's sections are a tenth of their size off or more).
+  double roundness_residual = INFINITY;
 };
 
 /// Measures `mesh` as a body of revolution. The axis is first, of the principal axes and the line

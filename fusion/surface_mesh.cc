@@ -103,6 +103,9 @@ void MeshingOptions::Check() const {
                 "meshing.bound_voxel_mm must be in [0.25, 20], got " << bound_voxel_mm);
   IHS_CHECK_ARG(bound_keep_seen_mm >= 0 && bound_keep_seen_mm <= 50,
                 "meshing.bound_keep_seen_mm must be in [0, 50], got " << bound_keep_seen_mm);
+  IHS_CHECK_ARG(
+      bound_revolve_max_residual >= 0 && bound_revolve_max_residual <= 1,
+      "meshing.bound_revolve_max_residual must be in [0, 1], got " << bound_revolve_max_residual);
 }
 
 TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction) {
@@ -316,12 +319,14 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
       bound_options.voxel_mm = options.bound_voxel_mm;
       bound_options.keep_seen_mm = options.bound_keep_seen_mm;
       bound_options.seen_hull = options.bound_by_seen_hull;
+      bound_options.revolve_max_residual = options.bound_revolve_max_residual;
       bound_options.min_component_fraction = options.min_component_fraction;
       ClosureBound bound = BoundClosure(result.watertight, result.smoothed,
                                         has_views ? *free_space : FreeSpace(), bound_options);
       result.watertight = std::move(bound.mesh);
       result.cut_share = bound.removed_share;
       result.hull_cut_share = bound.hull_share;
+      result.hull_revolved = bound.hull_revolved;
       result.bound_ms = MillisecondsSince(start);
     }
     result.unseen_share = UnseenShare(result.watertight, result.smoothed);

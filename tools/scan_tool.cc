@@ -117,6 +117,7 @@ nlohmann::json MeshSummary(const ihs::fusion::MeshingResult& meshes, double expo
             {"unseen_share", meshes.unseen_share},
             {"cut_share", meshes.cut_share},
             {"hull_cut_share", meshes.hull_cut_share},
+            {"hull_revolved", meshes.hull_revolved},
             {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
 }
 
@@ -157,9 +158,9 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
   if (meshes.cut_share > 0) {
     std::printf(
         "closure: %.1f %% of Poisson's volume cut away where the views saw empty space "
-        "(%.1f %%) or beyond the seen surface's convex hull (%.1f %%)\n",
+        "(%.1f %%) or beyond the seen surface's convex hull%s (%.1f %%)\n",
         100 * meshes.cut_share, 100 * (meshes.cut_share - meshes.hull_cut_share),
-        100 * meshes.hull_cut_share);
+        meshes.hull_revolved ? " (turned all round its axis)" : "", 100 * meshes.hull_cut_share);
   }
 }
 
