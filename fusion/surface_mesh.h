@@ -45,7 +45,7 @@ struct MeshingOptions {
   /// inside its own hull and stays). Costs a half-seen ball its unseen cap. Works without views.
   bool bound_by_seen_hull = true;
   /// When the seen surface is a body of revolution (its sections fit circles within this share
-  /// of their radius, RMS; the paper's scanned objects' 0.4-0.9 %, a box's about 9 %), the hull is
+  /// of their radius, RMS; the paper's objects scanned 0.4-0.9 %, a box 9-10 %), the hull is
   /// that of the seen surface turned all round its axis: the unseen ends are cut, the unseen side
   /// of a round object is left to Poisson (the plain hull cut it along a flat chord). 0: the plain
   /// hull.
