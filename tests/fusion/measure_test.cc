@@ -111,6 +111,15 @@ TEST(MeasureTest, TheAxisOfAHalfSeenSquatBottleIsItsSymmetryAxis) {
   EXPECT_GT(std::abs(m.axis.dot(true_axis)), std::cos(0.3 * M_PI / 180));
   EXPECT_NEAR(m.height_mm, 79, 0.5);
   EXPECT_NEAR(m.widest_diameter_mm, 52, 0.5);
+  // The point given on the axis is on it (the centroid of the half seen is 10 mm off it), and
+  // the sections are circles.
+  const Eigen::Vector3d off = m.axis_point - Eigen::Vector3d(12, -40, 610);
+  EXPECT_LT((off - off.dot(true_axis) * true_axis).norm(), 0.3);
+  EXPECT_GT((m.centre - Eigen::Vector3d(12, -40, 610) -
+             (m.centre - Eigen::Vector3d(12, -40, 610)).dot(true_axis) * true_axis)
+                .norm(),
+            5.0);
+  EXPECT_LT(m.roundness_residual, 0.01);
 }
 
 TEST(MeasureTest, ASmallBottleSeenFromBelowOnOneSideMeasuresItsHeight) {
