@@ -46,11 +46,12 @@ int main(int argc, char** argv) {
   std::string out, frames, preset, log_level = "info";
   bool no_noise = false, quiet = false, no_oni = false, no_tum = false;
   double slip_mm = 0;
-  app.add_option("--object", options.object,
-                 "sphere, water-bottle, bowling-pin, small-bottle, box or lathe:FILE")
+  app.add_option(
+         "--object", options.object,
+         "sphere, water-bottle, bowling-pin, small-bottle, box, plain-box, cube or lathe:FILE")
       ->capture_default_str();
   app.add_flag("--textured", options.textured,
-               "give a lathe object a checkerboard (default: one uniform colour)");
+               "give a lathe object or the cube a colour pattern (default: one uniform colour)");
   app.add_option("--motion", options.motion,
                  "scripted, or recorded:DIR (a session folder of the real hand data)")
       ->capture_default_str();

@@ -46,6 +46,36 @@ TEST(ObjectShapeTest, SignedDistanceOfTheSphereAndTheBox) {
   EXPECT_THROW(ObjectShape::FromSpec("teapot"), std::invalid_argument);
 }
 
+// The cube: three equal sides, one colour unless textured; the plain box: the box's shape in one
+// colour.
+TEST(ObjectShapeTest, TheCubeAndThePlainBox) {
+  const std::array<std::uint8_t, 3> blue = {70, 110, 200};
+  const ObjectShape cube = ObjectShape::FromSpec("cube", false, blue);
+  const auto [lo, hi] = cube.mesh().Bounds();
+  EXPECT_EQ(hi - lo, Eigen::Vector3f(60, 60, 60));
+  EXPECT_EQ(lo.z(), 0.0f);
+  EXPECT_NEAR(cube.mesh().Volume(), 60.0 * 60 * 60, 1e-2);
+  EXPECT_NEAR(cube.SignedDistance({0, 0, 30}), -30, 1e-9);
+  EXPECT_NEAR(cube.SignedDistance({0, 40, 30}), 10, 1e-9);
+  EXPECT_NEAR(cube.height_mm(), 60, 1e-9);
+  EXPECT_FALSE(cube.textured());
+  EXPECT_FALSE(cube.rotationally_symmetric());
+  for (const auto& c : cube.mesh().colors) ASSERT_EQ(c, blue);
+  const ObjectShape textured_cube = ObjectShape::FromSpec("cube", true, blue);
+  EXPECT_TRUE(textured_cube.textured());
+  const std::set<std::array<std::uint8_t, 3>> colours(textured_cube.mesh().colors.begin(),
+                                                      textured_cube.mesh().colors.end());
+  EXPECT_EQ(colours.size(), 12u);  // The box's checkerboard, a hue per side.
+
+  const ObjectShape box = ObjectShape::FromSpec("box", false, blue);
+  const ObjectShape plain = ObjectShape::FromSpec("plain-box", true, blue);
+  EXPECT_TRUE(box.textured());  // The box always has its pattern, the plain box never.
+  EXPECT_FALSE(plain.textured());
+  EXPECT_EQ(plain.mesh().Bounds(), box.mesh().Bounds());
+  EXPECT_EQ(plain.SignedDistance({33, 0, 95}), box.SignedDistance({33, 0, 95}));
+  for (const auto& c : plain.mesh().colors) ASSERT_EQ(c, blue);
+}
+
 // The signed distance the slow way: to every segment of the closed (r, z) outline but the axis,
 // inside by the crossings of a ray toward +r.
 double SignedDistanceOverEverySegment(const LatheProfile& profile, const Eigen::Vector3d& p) {

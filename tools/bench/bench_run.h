@@ -3,7 +3,7 @@
 // cached; every method scans the same frames. The hand tracker does not depend on the method, so
 // it runs once per frame and each method's object stage (correspondences, registration, ICP,
 // TSDF) gets its own copy of the tracked frame: all methods in one pass, on identical input.
-// The Open3D baseline gets the same frames with the hand's pixels removed by the ground truth.
+// The Open3D baselines get the same frames with the hand's pixels removed by the ground truth.
 
 #include <filesystem>
 #include <map>
@@ -19,7 +19,8 @@ namespace ihs::bench {
 /// A generator sequence.
 struct BenchCase {
   std::string name;    ///< e.g. "004-sphere", "sphere-turn".
-  std::string object;  ///< Generator object: sphere, water-bottle, bowling-pin, small-bottle, box.
+  /// Generator object: sphere, water-bottle, bowling-pin, small-bottle, box, plain-box, cube.
+  std::string object;
   std::string motion;  ///< "scripted" or "recorded:DIR".
   bool textured = false;
   /// Frames [0, frames) of the motion; 0: all.
@@ -49,10 +50,26 @@ std::vector<double> GammaSweep();
 /// Ours, visual only (γt = 0), contacts only, no ICP; then the sweep's other γt values.
 std::vector<Method> DefaultMethods(const std::vector<double>& sweep);
 
+/// A scripted full turn of the benchmark.
+struct FullTurn {
+  std::string name;    ///< e.g. "cube-turn".
+  std::string object;  ///< Generator object.
+  bool textured = false;
+  unsigned seed = 1;
+};
+
+/// The scripted full turns (the report's headline cases): sphere, bowling pin, water bottle,
+/// small bottle, a 60 mm cube, the 60 × 45 × 90 mm box in one colour and textured.
+std::vector<FullTurn> FullTurns();
+
+/// Whether the case is one of the scripted full turns.
+bool IsFullTurn(const BenchCase& bench_case);
+
 /// The paper's four sessions (object × its recorded motion; `data`: the hand data folder with
-/// sequences/), scripted full turns of the sphere and the bowling pin, and a textured box.
-/// `frames`: cap per case (0: whole); when it cuts the sessions, the sphere's whole session is a
-/// case of its own ("004-sphere-whole", for the volume). Without `data` only the scripted cases.
+/// sequences/), then the scripted full turns (FullTurns(), 240 frames, the hand tracker started
+/// from the truth's first pose). `frames`: cap per case (0: whole); when it cuts the sessions,
+/// the sphere's whole session is a case of its own ("004-sphere-whole", for the volume).
+/// Without `data` only the scripted cases.
 std::vector<BenchCase> DefaultCases(const std::filesystem::path& data, int frames);
 
 /// One method's result on one case.
@@ -86,7 +103,8 @@ struct CaseResult {
 
 struct RunOptions {
   std::filesystem::path work;  ///< Sequences (cached) and per-method outputs.
-  bool open3d = true;          ///< Run the Open3D baseline when built with it.
+  /// Run the Open3D baselines (frame to frame, frame to model) when built with Open3D.
+  bool open3d = true;
   /// `inhandscan` to time the application with (empty: skip).
   std::filesystem::path app;
   bool quiet = false;

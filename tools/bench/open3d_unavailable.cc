@@ -1,5 +1,5 @@
 // This build has no Open3D (libopen3d-dev was not found): the benchmark leaves the Open3D
-// baseline out, and constructing it says why.
+// baselines (frame to frame and frame to model) out, and constructing one says why.
 #include <stdexcept>
 
 #include "tools/bench/open3d_baseline.h"

@@ -1,8 +1,9 @@
 #pragma once
-// The benchmark's report: the paper's Table 1 (dimensions) and Table 2 (pairwise registration
-// error at the fingertips) per method, the hand tracker's joint error, surface and trajectory
-// errors, speed and memory, ratios to the baselines, the γt sweep; as Markdown (printed and
-// written), CSV and PNG plots and mesh pictures.
+// The benchmark's report: the full turns first (rotation followed, rotation error at the end,
+// drift, surface, volume per turn and method), the paper's Table 1 (dimensions) and Table 2
+// (pairwise registration error at the fingertips) per method, the hand tracker's joint error,
+// surface and trajectory errors, speed and memory, ratios to the baselines, the γt sweep; as
+// Markdown (printed and written), CSV and PNG plots and mesh pictures.
 
 #include <filesystem>
 #include <string>

@@ -27,6 +27,8 @@ double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
 ObjectShape ObjectShape::FromSpec(const std::string& spec, bool textured,
                                   std::array<std::uint8_t, 3> rgb) {
   if (spec == "box") return Box("box", Eigen::Vector3d(60, 45, 90));
+  if (spec == "plain-box") return Box("plain-box", Eigen::Vector3d(60, 45, 90), false, rgb);
+  if (spec == "cube") return Box("cube", Eigen::Vector3d(60, 60, 60), textured, rgb);
   if (spec.rfind("lathe:", 0) == 0) {
     const std::string file = spec.substr(6);
     if (file.empty()) throw std::invalid_argument("--object lathe:FILE needs a file name");
@@ -36,7 +38,7 @@ ObjectShape ObjectShape::FromSpec(const std::string& spec, bool textured,
   if (std::find(names.begin(), names.end(), spec) == names.end()) {
     throw std::invalid_argument("unknown object '" + spec +
                                 "' (sphere, water-bottle, bowling-pin, small-bottle, box, "
-                                "lathe:FILE)");
+                                "plain-box, cube, lathe:FILE)");
   }
   return Lathe(spec, PaperObjectProfile(spec), rgb, textured);
 }
@@ -79,13 +81,15 @@ ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& prof
   return shape;
 }
 
-ObjectShape ObjectShape::Box(const std::string& name, const Eigen::Vector3d& size) {
+ObjectShape ObjectShape::Box(const std::string& name, const Eigen::Vector3d& size, bool textured,
+                             std::array<std::uint8_t, 3> rgb) {
   ObjectShape shape;
   shape.name_ = name;
   shape.mesh_ = MakeTexturedBox(size);
+  if (!textured) shape.mesh_.colors.assign(shape.mesh_.vertices.size(), rgb);
   shape.height_mm_ = size.z();
   shape.max_radius_mm_ = size.head<2>().norm() / 2;
-  shape.textured_ = true;
+  shape.textured_ = textured;
   shape.box_ = true;
   shape.box_size_ = size;
   return shape;

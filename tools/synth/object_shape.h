@@ -16,9 +16,11 @@ namespace ihs::synth {
 class ObjectShape {
  public:
   /// "sphere", "water-bottle", "bowling-pin", "small-bottle" (the paper's objects), "box" (a
-  /// textured 60 × 45 × 90 mm box) or "lathe:FILE" (a profile file of "height radius" lines).
+  /// textured 60 × 45 × 90 mm box), "plain-box" (the same box in one colour, `rgb`), "cube" (a
+  /// 60 mm cube) or "lathe:FILE" (a profile file of "height radius" lines).
   /// Throws std::invalid_argument for an unknown name and ihs::InputError for a bad file.
-  /// `textured`: lathe objects get a colour pattern in `rgb` too (the box always has its own).
+  /// `textured`: lathe objects and the cube get a colour pattern (lathe objects in `rgb`; the
+  /// cube the box's); "box" always has its pattern, "plain-box" never.
   static ObjectShape FromSpec(const std::string& spec, bool textured = false,
                               std::array<std::uint8_t, 3> rgb = {235, 235, 235});
   /// A surface of revolution about +z, uniform colour `rgb`; textured: a checkerboard of 12
@@ -26,8 +28,10 @@ class ObjectShape {
   static ObjectShape Lathe(const std::string& name, const LatheProfile& profile,
                            std::array<std::uint8_t, 3> rgb = {235, 235, 235},
                            bool textured = false);
-  /// A textured box of `size` (x, y, z) mm standing on z = 0, centred on the axis.
-  static ObjectShape Box(const std::string& name, const Eigen::Vector3d& size);
+  /// A box of `size` (x, y, z) mm standing on z = 0, centred on the axis; textured: a
+  /// checkerboard with a hue per face (MakeTexturedBox), else one uniform colour `rgb`.
+  static ObjectShape Box(const std::string& name, const Eigen::Vector3d& size, bool textured = true,
+                         std::array<std::uint8_t, 3> rgb = {235, 235, 235});
 
   const std::string& name() const { return name_; }
   /// The mesh in the object frame (mm), with vertex colours.

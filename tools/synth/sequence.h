@@ -34,9 +34,10 @@ namespace ihs::synth {
 
 /// Everything that defines a sequence; written to the manifest.
 struct SequenceOptions {
-  /// ObjectShape::FromSpec name: sphere, water-bottle, bowling-pin, small-bottle, box, lathe:FILE.
+  /// ObjectShape::FromSpec name: sphere, water-bottle, bowling-pin, small-bottle, box,
+  /// plain-box, cube, lathe:FILE.
   std::string object = "sphere";
-  /// Give a lathe object a colour pattern (a checkerboard); by default it is one uniform colour.
+  /// Give a lathe object or the cube a colour pattern; by default it is one uniform colour.
   bool textured = false;
   /// "scripted", or "recorded:DIR" with DIR a session folder of the real hand data (holding
   /// Model_Hand_R.SKEL and .MOTION).
