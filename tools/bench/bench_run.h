@@ -30,8 +30,8 @@ struct BenchCase {
   /// Seed of the generator's random choices (noise, sway, slip).
   unsigned seed = 1;
   /// Start the hand tracker from the ground truth's first pose instead of letting it find the
-  /// hand: the scripted motions start with the hand already around the object, where the
-  /// tracker's own initialisation (an open hand shown first, as a user does) has nothing to go on.
+  /// hand (to tell the tracker's share of an error from the registration's; no default case
+  /// does: a user's scan initialises itself).
   bool init_from_gt = false;
 };
 
