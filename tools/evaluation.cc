@@ -328,6 +328,19 @@ void ReportVolume(double truth_mm3, const TriangleMesh& watertight,
   if (out) std::fprintf(out, "\n");
 }
 
+bool IsBodyOfRevolution(const std::string& object) {
+  const std::vector<std::string> names = synth::PaperObjectNames();
+  return object.rfind("lathe:", 0) == 0 ||
+         std::find(names.begin(), names.end(), object) != names.end();
+}
+
+std::string NotABodyOfRevolution(const std::string& object) {
+  return IsBodyOfRevolution(object) ? std::string()
+                                    : "unknown object '" + object +
+                                          "' (sphere, water-bottle, bowling-pin, small-bottle, "
+                                          "lathe:FILE)";
+}
+
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const fs::path& gt_dir,
                           const std::vector<StampedPose>& trajectory,
@@ -337,7 +350,12 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
     if (out) std::fprintf(out, format, values...);
   };
   nlohmann::json report = nlohmann::json::object();
-  if (!object.empty()) {
+  if (!IsBodyOfRevolution(object)) {
+    if (!gt_dir.empty() && watertight.IsWatertight() && fs::exists(gt_dir / "object.ply")) {
+      ReportVolume(ReadMesh(gt_dir / "object.ply").Volume(), watertight, unseen_share, out,
+                   &report);
+    }
+  } else {
     report.update(DimensionReport(object, seen, "", print));
     // What the user takes away: the same measures on the closed mesh, where it is another.
     if (&watertight != &seen && !watertight.faces.empty()) {

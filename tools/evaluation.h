@@ -117,11 +117,20 @@ ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
 /// "turned_deg") and `seen` against the true surface ("pairwise_error_mm", "trajectory_error_mm",
 /// "chamfer_mm", "completeness" within "completeness_within_mm"), `seen` placed by `trajectory`.
 /// With `unseen_share` (the share of `watertight`'s surface no frame saw: fusion::UnseenShare,
-/// which every export computes) the volume comes with it ("volume_unseen_share").
+/// which every export computes) the volume comes with it ("volume_unseen_share"). An `object`
+/// the paper's measures do not know (IsBodyOfRevolution: a box, a cube) or none gets no
+/// dimensions; with `gt_dir` its volume is then measured against gt/object.ply's.
 nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
                           const TriangleMesh& watertight, const std::filesystem::path& gt_dir,
                           const std::vector<StampedPose>& trajectory,
                           std::optional<double> unseen_share, std::FILE* out = stdout);
+
+/// Whether the paper's measures know `object` (a generator object's name or spec): the paper's
+/// four bodies of revolution and "lathe:FILE".
+bool IsBodyOfRevolution(const std::string& object);
+
+/// Why `object` is not one (a command-line option's error), or "" when it is.
+std::string NotABodyOfRevolution(const std::string& object);
 
 /// The volume of `watertight` against `truth_mm3` (ReportScan's line; e.g. gt/object.ply's volume
 /// for an object that is no body of revolution), printed to `out` unless it is null and added to

@@ -104,11 +104,6 @@ int Run(const MeasureArgs& args) {
       args.seen.empty() ? std::nullopt : std::optional(ihs::fusion::UnseenShare(mesh, seen));
   out.update(ihs::eval::ReportScan(args.object, args.seen.empty() ? mesh : seen, mesh, args.gt,
                                    trajectory, unseen_share, table));
-  if (args.object.empty() && !args.gt.empty() && mesh.IsWatertight()) {
-    // No body of revolution named (the box): the volume against the true object's mesh.
-    ihs::eval::ReportVolume(ihs::ReadMesh(fs::path(args.gt) / "object.ply").Volume(), mesh,
-                            unseen_share, table, &out);
-  }
   if (args.summary) PrintSummary(out);
   if (!args.json.empty()) ihs::WriteFileAtomically(args.json, out.dump(1) + "\n");
   return ihs::kExitOk;
@@ -129,7 +124,8 @@ int main(int argc, char** argv) {
   app.add_option("mesh", args.mesh, "the scanned mesh (PLY, OBJ, STL)")->required();
   app.add_option("--object", args.object,
                  "what was scanned: sphere, water-bottle, bowling-pin, small-bottle or "
-                 "lathe:FILE (the paper's measures against its true dimensions)");
+                 "lathe:FILE (the paper's measures against its true dimensions)")
+      ->check(ihs::eval::NotABodyOfRevolution);
   app.add_option("--seen", args.seen,
                  "the seen surface of a scan whose MESH is watertight (mesh_tsdf.ply beside "
                  "mesh.ply): the dimensions and the surface errors are measured on it, the volume "

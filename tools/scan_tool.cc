@@ -174,8 +174,8 @@ nlohmann::json Evaluate(const Args& args, const std::string& object,
   // closing of what was never seen (a base under the hand) is guesswork that would add to a
   // bottle's height. The volume needs the watertight mesh.
   nlohmann::json evaluation =
-      ihs::eval::ReportScan(object == "box" ? "" : object, meshes.smoothed, meshes.watertight,
-                            args.gt, record.trajectory(), meshes.unseen_share);
+      ihs::eval::ReportScan(object, meshes.smoothed, meshes.watertight, args.gt,
+                            record.trajectory(), meshes.unseen_share);
   const ihs::eval::ContactUse use = ihs::eval::CompareContactUse(args.gt, contact_use);
   std::printf(
       "contacts used in %d of %d frames where the truth grasps (%.0f %%); %d of %d frames with "
@@ -263,7 +263,8 @@ int main(int argc, char** argv) {
   app.add_option("--gt", args.gt, "a generator's gt/ folder: measure the scan against it");
   app.add_option("--object", args.object,
                  "what was scanned, for its dimensions (a paper object or lathe:FILE; default: "
-                 "the ground truth's)");
+                 "the ground truth's)")
+      ->check(ihs::eval::NotABodyOfRevolution);
   app.add_flag("--init-from-gt", args.init_from_gt, "start the hand from the ground truth's pose");
   app.add_option("--template", args.template_name, "procedural, or the real hand data folder")
       ->capture_default_str();

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -169,6 +170,28 @@ TEST_F(EvaluationTest, TheTrueObjectMatchesItselfPlacedByTheTrajectory) {
   EXPECT_NEAR(rows[0].truth_mm, 70.0, 0.1);
   EXPECT_NEAR(TrueVolume("sphere") / (4.0 / 3.0 * M_PI * 35 * 35 * 35), 1.0, 0.002);
   EXPECT_THROW(PaperDimensions("teapot", object), std::invalid_argument);
+}
+
+TEST_F(EvaluationTest, AnObjectWithoutThePapersMeasuresGetsItsVolumeFromTheTruthsMesh) {
+  EXPECT_TRUE(IsBodyOfRevolution("sphere"));
+  EXPECT_TRUE(IsBodyOfRevolution("lathe:profile.txt"));
+  EXPECT_FALSE(IsBodyOfRevolution("cube"));
+  EXPECT_FALSE(IsBodyOfRevolution(""));
+  EXPECT_NE(NotABodyOfRevolution("cube").find("unknown object 'cube'"), std::string::npos);
+  EXPECT_EQ(NotABodyOfRevolution("water-bottle"), "");
+  // A scan named as a cube or a plain box (no dimensions): the volume of its closed mesh against
+  // gt/object.ply's, whatever the name; the same mesh scaled by 1.1 is 33.1 % larger.
+  const TriangleMesh object = ReadMesh(Gt() / "object.ply");
+  TriangleMesh larger = object;
+  for (auto& v : larger.vertices) v *= 1.1f;
+  const auto trajectory = ReadTumTrajectory(Gt() / "trajectory.txt");
+  for (const std::string name : {"cube", "plain-box", ""}) {
+    const nlohmann::json report =
+        ReportScan(name, larger, larger, Gt(), trajectory, std::nullopt, nullptr);
+    EXPECT_FALSE(report.contains("dimensions")) << name;
+    ASSERT_TRUE(report.contains("volume_error")) << name;
+    EXPECT_NEAR(report["volume_error"].get<double>(), 0.331, 0.002) << name;
+  }
 }
 
 }  // namespace

@@ -146,15 +146,8 @@ void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const fusion::Mo
   result.measures["export_ms"] = MillisecondsSince(start);
   result.measures["poisson_ms"] = meshes.poisson_ms;
   // The paper's measures know bodies of revolution; a box's volume is its true mesh's.
-  const auto lathes = synth::PaperObjectNames();
-  const bool lathe = std::find(lathes.begin(), lathes.end(), c.object) != lathes.end() ||
-                     c.object.rfind("lathe:", 0) == 0;
-  result.measures.update(eval::ReportScan(lathe ? c.object : "", meshes.smoothed, meshes.watertight,
-                                          gt_dir, result.trajectory, meshes.unseen_share, nullptr));
-  if (!lathe && meshes.watertight.IsWatertight()) {
-    eval::ReportVolume(ReadMesh(gt_dir / "object.ply").Volume(), meshes.watertight,
-                       meshes.unseen_share, nullptr, &result.measures);
-  }
+  result.measures.update(eval::ReportScan(c.object, meshes.smoothed, meshes.watertight, gt_dir,
+                                          result.trajectory, meshes.unseen_share, nullptr));
   result.seen = std::move(meshes.smoothed);
   result.watertight = std::move(meshes.watertight);
 }
