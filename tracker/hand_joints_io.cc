@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/check.h"
 #include "core/errors.h"
+#include "tracker/hand_pose.h"
 
 namespace ihs::tracker {
 
@@ -103,11 +104,6 @@ HandSides CompareHandSides(const HandModel& model, const std::vector<Eigen::Vect
   IHS_CHECK_ARG(estimate_mm.size() == joints && truth_mm.size() == joints,
                 "CompareHandSides: " << estimate_mm.size() << " and " << truth_mm.size()
                                      << " joints for a model of " << joints);
-  auto end_of = [&](const std::string& bone) {
-    const int index = model.BoneIndex(bone);
-    IHS_CHECK_ARG(index >= 0, "CompareHandSides: the model has no bone " << bone);
-    return static_cast<size_t>(index + 1);
-  };
   // Fingertips: the ends of the end effectors, by finger (0 little, 4 thumb).
   size_t tips[5] = {0, 0, 0, 0, 0};
   for (int bone : model.EndEffectors()) {
@@ -117,15 +113,11 @@ HandSides CompareHandSides(const HandModel& model, const std::vector<Eigen::Vect
   const size_t thumb = tips[4], little = tips[0];
   IHS_CHECK_ARG(thumb > 0 && little > 0,
                 "CompareHandSides: the model has no thumb or little finger");
-  const size_t index_knuckle = end_of("RFing.3_Hand"), little_knuckle = end_of("RFing.0_Hand"),
-               middle_knuckle = end_of("RFing.2_Hand");
-  auto palm_normal = [&](const std::vector<Eigen::Vector3d>& j) {
-    return (j[index_knuckle] - j[little_knuckle]).cross(j[middle_knuckle] - j[0]);
-  };
   HandSides sides;
   sides.thumb_swapped = (estimate_mm[thumb] - truth_mm[little]).norm() <
                         (estimate_mm[thumb] - truth_mm[thumb]).norm();
-  sides.palm_reversed = palm_normal(estimate_mm).dot(palm_normal(truth_mm)) < 0;
+  sides.palm_reversed =
+      PalmAxesOf(model, estimate_mm).Normal().dot(PalmAxesOf(model, truth_mm).Normal()) < 0;
   return sides;
 }
 

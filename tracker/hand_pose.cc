@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <string>
 
 #include "core/check.h"
 
@@ -85,6 +86,24 @@ HandPose PoseFromBoneTransforms(const HandModel& model, const std::vector<Rigid3
   return pose;
 }
 
+PalmAxes PalmAxesOf(const HandModel& model, const std::vector<Eigen::Vector3d>& joints) {
+  IHS_CHECK_ARG(joints.size() == model.bones.size() + 1,
+                joints.size() << " joints for a model of " << model.bones.size() + 1);
+  auto knuckle = [&](int finger) {
+    const std::string bone = "RFing." + std::to_string(finger) + "_Hand";
+    const int index = model.BoneIndex(bone);
+    IHS_CHECK_ARG(index >= 0, "the hand model has no bone " << bone);
+    return joints[static_cast<size_t>(index + 1)];
+  };
+  PalmAxes axes;
+  axes.across = knuckle(3) - knuckle(0);
+  axes.along = knuckle(2) - joints[0];
+  axes.centre = joints[0];
+  for (int finger = 0; finger < 4; ++finger) axes.centre += knuckle(finger);
+  axes.centre /= 5.0;
+  return axes;
+}
+
 bool IsRightHand(const HandModel& model) {
   const auto dofs = JointDegreesOfFreedom(model);
   const HandPose rest = HandPose::Rest(model);
@@ -94,15 +113,10 @@ bool IsRightHand(const HandModel& model) {
   }
   const auto joints = model.JointPositions(ForwardKinematics(model, rest));
   const auto bent = model.JointPositions(ForwardKinematics(model, flexed));
-  auto end_of = [&](const char* bone) {
-    const int index = model.BoneIndex(bone);
-    IHS_CHECK_ARG(index >= 0, "IsRightHand: the model has no bone " << bone);
-    return static_cast<size_t>(index + 1);
-  };
-  const Eigen::Vector3d across = joints[end_of("RFing.3_Hand")] - joints[end_of("RFing.0_Hand")];
-  const Eigen::Vector3d along = joints[end_of("RFing.2_Hand")] - joints[0];
-  const size_t tip = end_of("RFing.2_2");
-  return across.cross(along).dot(bent[tip] - joints[tip]) > 0;
+  const int middle_tip = model.BoneIndex("RFing.2_2");
+  IHS_CHECK_ARG(middle_tip >= 0, "IsRightHand: the model has no bone RFing.2_2");
+  const size_t tip = static_cast<size_t>(middle_tip + 1);
+  return PalmAxesOf(model, joints).Normal().dot(bent[tip] - joints[tip]) > 0;
 }
 
 }  // namespace ihs::tracker

@@ -41,6 +41,18 @@ std::vector<Rigid3> ForwardKinematics(const HandModel& model, const HandPose& po
 /// clamped to the limits. Used to initialise a fit from recorded motion.
 HandPose PoseFromBoneTransforms(const HandModel& model, const std::vector<Rigid3>& cam_from_bone);
 
+/// The palm's axes from joints in HandModel::JointPositions' layout (the bones
+/// "RFing.<finger>_Hand" end at the knuckles): `across` from the little finger's knuckle to the
+/// index finger's, `along` from the first joint (the root's start) to the middle finger's
+/// knuckle, `centre` the mean of the first joint and the four knuckles. Throws
+/// std::invalid_argument for a model without those bones or joints of another count.
+struct PalmAxes {
+  Eigen::Vector3d across, along, centre;
+  /// across × along: toward the palm for a right hand, toward its back for a left one.
+  Eigen::Vector3d Normal() const { return across.cross(along); }
+};
+PalmAxes PalmAxesOf(const HandModel& model, const std::vector<Eigen::Vector3d>& joints);
+
 /// Whether `model` is a right hand: the direction across its knuckles from the little finger
 /// (RFing.0) to the index (RFing.3), crossed with the direction from the wrist to the middle
 /// knuckle, points to its palm (the side to which flexion takes the middle fingertip). A left

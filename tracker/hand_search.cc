@@ -186,18 +186,10 @@ HandPose CurledHand(const HandModel& model, double fraction) {
 }
 
 HandPose TurnedOver(const HandModel& model, const HandPose& pose) {
-  const std::vector<Eigen::Vector3d> joints = model.JointPositions(ForwardKinematics(model, pose));
-  Eigen::Vector3d middle = joints[0];
-  for (int finger = 0; finger < 4; ++finger) {
-    const int knuckle = model.BoneIndex("RFing." + std::to_string(finger) + "_Hand");
-    IHS_CHECK_ARG(knuckle >= 0, "TurnedOver: the model has no bone RFing." << finger << "_Hand");
-    middle += joints[knuckle + 1];
-  }
-  middle /= 5.0;
-  const Eigen::Vector3d along = joints[model.BoneIndex("RFing.2_Hand") + 1] - joints[0];
-  const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI, along.normalized()).toRotationMatrix();
+  const PalmAxes palm = PalmAxesOf(model, model.JointPositions(ForwardKinematics(model, pose)));
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI, palm.along.normalized()).toRotationMatrix();
   HandPose out = pose;
-  out.cam_from_root = Rigid3(turn, middle - turn * middle) * pose.cam_from_root;
+  out.cam_from_root = Rigid3(turn, palm.centre - turn * palm.centre) * pose.cam_from_root;
   return out;
 }
 

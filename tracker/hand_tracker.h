@@ -65,9 +65,10 @@ struct TrackerOptions {
   /// too (initialisation_iterations), and replaces the fit when it explains the hand better;
   /// when it explains it within flip_tie_score as well (FitScore's units: mm of mean distance,
   /// 20 per share of points unexplained), the pose is doubtful. On the 22 generated sequences
-  /// of tools/bench_hand_init.sh (seed 1000) it never came close (turned over 14.6–35 against
-  /// 3.5–9.7, the wrong fits there are misplaced, not turned over) and costs about a tenth more
-  /// fit time at 10 frames (docs/tracker.md); it guards against the held-out palm-for-back fit.
+  /// of tools/bench_hand_init.sh (seed 1000) it neither won nor tied once (on one of them the
+  /// turned-over fit scored 14.6–35 against 3.5–9.7: the wrong fits there are misplaced, not
+  /// turned over) and costs about a tenth more fit time at 10 frames (docs/tracker.md); it
+  /// guards against the held-out palm-for-back fit.
   int flip_check_frames = 10;
   double flip_tie_score = 0.5;
 
