@@ -49,6 +49,14 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("mask_ms", packet.mask_ms);
     timing("features_ms", packet.features_ms);
     entry["hand_pixels_removed"] = packet.hand_pixels_removed;
+    if (!track.contacts.bones.empty()) {
+      entry["contact_bones"] = track.contacts.bones.size();
+      entry["contact_threshold_mm"] = track.contacts.threshold_mm;
+      if (track.contacts.held_frames > 0) {
+        entry["contact_held_frames"] = track.contacts.held_frames;
+        ++held_grasp_frames_;
+      }
+    }
     nlohmann::json& matches = entry["matches"] = nlohmann::json::object();
     for (const auto& [source, count] : packet.matches) matches[source] = count;
     if (!track.joints_mm.empty()) joints_.push_back({frame.index, track.joints_mm});
@@ -134,6 +142,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"track_status_counts", track_counts_},
                             {"hand_doubtful_frames", doubtful_frames_},
                             {"hand_turned_over_frames", turned_over_frames_},
+                            {"held_grasp_frames", held_grasp_frames_},
                             {"fusion_status_counts", fusion_counts_},
                             {"skip_reasons", skip_reasons_},
                             {"coverage", coverage_},

@@ -104,6 +104,19 @@ void AddContactOptions(OptionRegistry& r, tracker::ContactOptions* contacts) {
   r.Add("tracker.contacts.min_bones", &c.min_bones, "contact bones wanted (paper: 2)");
 }
 
+void AddGraspHoldOptions(OptionRegistry& r, tracker::GraspHoldOptions* hold) {
+  tracker::GraspHoldOptions& h = *hold;
+  r.Add("tracker.grasp_hold.enabled", &h.enabled,
+        "hold a detected grasp through frames the detection misses while the hand keeps its "
+        "shape (off: the paper's per-frame contacts)");
+  r.Add("tracker.grasp_hold.max_shape_change_mm", &h.max_shape_change_mm,
+        "a held fingertip moving farther in the hand's frame lets go, mm");
+  r.Add("tracker.grasp_hold.max_reach_mm", &h.max_reach_mm,
+        "a held fingertip farther from every object point lets go, mm");
+  r.Add("tracker.grasp_hold.max_frames", &h.max_frames,
+        "frames in a row a grasp is held without being detected at most");
+}
+
 // The fusion's sub-groups: the TSDF volume, and the registration (pairwise and ICP).
 void AddTsdfOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
   fusion::FusionOptions& u = *fusion;
@@ -207,6 +220,7 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
   AddSegmentationOptions(r, &t.segmentation);
   AddHandFitOptions(r, &t.fit);
   AddContactOptions(r, &t.contacts);
+  AddGraspHoldOptions(r, &t.grasp_hold);
 }
 
 void AddFeatureOptions(OptionRegistry& r, fusion::SiftOptions* sift, fusion::ShotOptions* shot) {

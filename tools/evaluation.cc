@@ -7,12 +7,14 @@
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
 #include "core/data_lines.h"
 #include "core/errors.h"
 #include "core/mesh_io.h"
 #include "core/point_kd_tree.h"
+#include "render/offscreen_renderer.h"
 #include "tools/synth/objects.h"
 #include "tracker/hand_joints_io.h"
 
@@ -256,8 +258,13 @@ ContactUse CompareContactUse(const fs::path& gt_dir, const std::vector<FrameCont
     const TrueContacts& contacts = touch->second;
     const int touching =
         static_cast<int>(std::count(contacts.touch.begin(), contacts.touch.end(), true));
-    const double nearest =
-        *std::min_element(contacts.distance_mm.begin(), contacts.distance_mm.end());
+    double nearest = 1e9;
+    for (int finger = 0; finger < static_cast<int>(contacts.distance_mm.size()); ++finger) {
+      if (frame.fingers.empty() ||
+          std::count(frame.fingers.begin(), frame.fingers.end(), finger) > 0) {
+        nearest = std::min(nearest, contacts.distance_mm[finger]);
+      }
+    }
     if (touching >= 2) {
       ++use.grasp_frames;
       use.used_in_grasp += frame.used;
@@ -326,6 +333,54 @@ void ReportVolume(double truth_mm3, const TriangleMesh& watertight,
     (*report)["volume_unseen_share"] = *unseen_share;
   }
   if (out) std::fprintf(out, "\n");
+}
+
+ShownSurface::ShownSurface(const fs::path& gt_dir, const CameraIntrinsics& intrinsics)
+    : gt_dir_(gt_dir),
+      intrinsics_(intrinsics),
+      truth_(ReadTumTrajectory(gt_dir / "trajectory.txt")) {
+  for (const char* needed : {"labels", "object.ply"}) {
+    if (!fs::exists(gt_dir / needed)) throw InputError((gt_dir / needed).string() + ": missing");
+  }
+}
+
+void ShownSurface::Add(const Frame& frame) {
+  const StampedPose* pose = FindPose(truth_, frame.depth_timestamp_us * 1e-6);
+  if (!pose) return;
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d.png", static_cast<int>(pose - truth_.data()));
+  const cv::Mat labels = cv::imread((gt_dir_ / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
+  if (labels.cols != frame.width || labels.rows != frame.height) {
+    throw InputError((gt_dir_ / "labels" / name).string() + ": missing or not the frame's size");
+  }
+  const Rigid3 object_from_cam = pose->transform.Inverse();
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      const std::uint16_t depth = frame.depth_mm[static_cast<size_t>(v) * frame.width + u];
+      if (depth == 0 || labels.at<std::uint8_t>(v, u) != render::kObject) continue;
+      const Eigen::Vector3d p = object_from_cam * intrinsics_.BackProject(u, v, depth);
+      // A millimetre cube's key (the object lies within ±1 m of its origin).
+      const Eigen::Array3i cell = (p.array().floor() + 1024).cast<int>().min(2047).max(0);
+      points_.try_emplace((std::int64_t{cell.x()} << 22) | (cell.y() << 11) | cell.z(),
+                          p.cast<float>());
+    }
+  }
+}
+
+double ShownSurface::Share(double within_mm) const {
+  std::vector<Eigen::Vector3f> shown;
+  shown.reserve(points_.size());
+  for (const auto& entry : points_) shown.push_back(entry.second);
+  const PointKdTree tree(std::move(shown));
+  const std::vector<Eigen::Vector3f> truth =
+      fusion::SampleSurface(ReadMesh(gt_dir_ / "object.ply"), 1.0);
+  if (truth.empty()) return 0;
+  int near = 0;
+  for (const Eigen::Vector3f& p : truth) {
+    float distance_sq = 0;
+    near += tree.Nearest(p, &distance_sq) >= 0 && distance_sq <= within_mm * within_mm;
+  }
+  return static_cast<double>(near) / truth.size();
 }
 
 bool IsBodyOfRevolution(const std::string& object) {

@@ -4,13 +4,18 @@
 // and the surface's Chamfer distance and completeness after aligning by the known trajectory.
 // Shared by inhandscan-scan, inhandscan-measure and the benchmark.
 
+#include <Eigen/Core>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
 #include "core/trajectory_io.h"
 #include "core/triangle_mesh.h"
 #include "fusion/measure.h"
@@ -90,11 +95,17 @@ TrajectoryError CompareTrajectory(const std::filesystem::path& gt_dir,
 struct FrameContactUse {
   double time_s = 0;
   bool used = false;
+  /// The fingers the tracker found touching (0 pinky, 1 ring, 2 middle, 3 index, 4 thumb, as
+  /// HandModel::FingerOf); empty: not known, any finger counts.
+  std::vector<int> fingers;
 };
 
 /// The contacts against the truth (gt/contacts.csv): of the frames where the truth has at least
 /// two fingertips touching the object (a grasp), how many used contacts (recall); of the frames
-/// that used contacts, how many had no fingertip within `false_mm` of the object (false contacts).
+/// that used contacts, how many had none of their fingers (FrameContactUse::fingers; any
+/// finger where they are not known) within `false_mm` of the object (false contacts). Judged by
+/// the fingers used: the scripted grasps curl the ring and little fingers 3 mm from the object
+/// all along, and a frame whose contacts were fingers hovering 9 mm away counted as true.
 struct ContactUse {
   int grasp_frames = 0;
   int used_in_grasp = 0;
@@ -105,6 +116,32 @@ struct ContactUse {
 };
 ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
                              const std::vector<FrameContactUse>& frames, double false_mm = 3.0);
+
+/// What a recording showed of the object at all: every frame's object pixels (gt/labels/, the
+/// generator's) back-projected from the frame's own depth and placed in the truth's object frame
+/// by the truth's pose. The share of the true surface within `within_mm` of those points is the
+/// completeness a scan of this recording could reach with perfect registration (the bottom of a
+/// bottle the camera never faces, a ball's patch always under the fingers are missing from it):
+/// the scale a scan's completeness is read on.
+class ShownSurface {
+ public:
+  /// Throws InputError when `gt_dir` lacks its trajectory, labels or object.
+  ShownSurface(const std::filesystem::path& gt_dir, const CameraIntrinsics& intrinsics);
+
+  /// Adds `frame`'s object pixels (its depth timestamp finds the truth's pose and labels; a
+  /// frame the truth does not have adds nothing).
+  void Add(const Frame& frame);
+
+  /// The share of the true surface (gt/object.ply) within `within_mm` of what was shown.
+  double Share(double within_mm = 2.0) const;
+
+ private:
+  std::filesystem::path gt_dir_;
+  CameraIntrinsics intrinsics_;
+  std::vector<StampedPose> truth_;
+  // One shown point per millimetre cube of the object frame.
+  std::unordered_map<std::int64_t, Eigen::Vector3f> points_;
+};
 
 /// Prints a scan's measures as a table for people on `out` (nullptr: prints nothing) and returns
 /// them as JSON: with

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "app/run_record.h"
@@ -166,16 +167,34 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
 
 // The scan against the ground truth (printed; returned for stats.json): the paper's measures
 // and the surface's distances, and how the contacts were used where the truth grasps.
+// The fingers of the tracker's contact bones in this frame (what the evaluation judges the
+// frame's contacts by).
+std::vector<int> ContactFingers(const ihs::tracker::HandModel& model,
+                                const ihs::tracker::Contacts& contacts) {
+  std::vector<int> fingers;
+  for (int bone : contacts.bones) {
+    if (const int finger = model.FingerOf(bone); finger >= 0) fingers.push_back(finger);
+  }
+  return fingers;
+}
+
 nlohmann::json Evaluate(const Args& args, const std::string& object,
                         const ihs::app::ScanRecord& record,
                         const ihs::fusion::MeshingResult& meshes,
-                        const std::vector<ihs::eval::FrameContactUse>& contact_use) {
+                        const std::vector<ihs::eval::FrameContactUse>& contact_use,
+                        const ihs::eval::ShownSurface& shown) {
   // Dimensions and distances on the surface that was seen (the TSDF's, smoothed); Poisson's
   // closing of what was never seen (a base under the hand) is guesswork that would add to a
   // bottle's height. The volume needs the watertight mesh.
   nlohmann::json evaluation =
       ihs::eval::ReportScan(object, meshes.smoothed, meshes.watertight, args.gt,
                             record.trajectory(), meshes.unseen_share);
+  // The completeness perfect registration would reach: what the frames showed at all.
+  const double shown_share = shown.Share(evaluation.value("completeness_within_mm", 2.0));
+  std::printf(
+      "the recording showed %.1f %% of the true surface (the completeness a scan can reach)\n",
+      100 * shown_share);
+  evaluation["shown_share"] = shown_share;
   const ihs::eval::ContactUse use = ihs::eval::CompareContactUse(args.gt, contact_use);
   std::printf(
       "contacts used in %d of %d frames where the truth grasps (%.0f %%); %d of %d frames with "
@@ -202,10 +221,14 @@ int Run(const Args& args) {
   PrepareOutput(out);
 
   std::vector<ihs::eval::FrameContactUse> contact_use;
+  std::optional<ihs::eval::ShownSurface> shown;
+  if (!args.gt.empty()) shown.emplace(args.gt, scan.intrinsics());
   const auto run_start = ihs::SteadyClock::now();
   const std::int64_t frames = scan.Run(hand, [&](ihs::app::FramePacket& packet) {
     ihs::app::ScanObject(object_stage, record, packet);
-    contact_use.push_back({packet.frame->depth_timestamp_us * 1e-6, packet.fusion.ContactsUsed()});
+    contact_use.push_back({packet.frame->depth_timestamp_us * 1e-6, packet.fusion.ContactsUsed(),
+                           ContactFingers(hand.model(), packet.track.contacts)});
+    if (shown && packet.frame) shown->Add(*packet.frame);
   });
   const double run_s = ihs::MillisecondsSince(run_start) / 1000.0;
 
@@ -239,7 +262,7 @@ int Run(const Args& args) {
   extra.update(MeshSummary(exported.meshes, export_ms, marching_cubes_ms));
   PrintSummary(frames, record, summary, exported.meshes, export_ms, marching_cubes_ms, out);
   if (!args.gt.empty()) {
-    extra["evaluation"] = Evaluate(args, object, record, exported.meshes, contact_use);
+    extra["evaluation"] = Evaluate(args, object, record, exported.meshes, contact_use, *shown);
   }
   record.WriteStats(out / "stats.json", extra);
   return ihs::kExitOk;

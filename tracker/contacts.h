@@ -48,6 +48,9 @@ struct Contacts {
   /// The threshold at which they were found, mm (the first one, `start_mm`, when the growth
   /// found no grasp).
   double threshold_mm = 0;
+  /// 0 when detected in this frame; else how many frames the grasp has been held without
+  /// being detected (GraspHold), this one included.
+  int held_frames = 0;
 };
 
 /// Finds contacts of a posed hand with the object's points.

@@ -42,6 +42,7 @@ void TrackerOptions::Check() const {
   segmentation.Check();
   fit.Check();
   contacts.Check();
+  grasp_hold.Check();
   IHS_CHECK_ARG(min_hand_points >= 10, "tracker.min_hand_points must be >= 10");
   IHS_CHECK_ARG(min_data_coverage >= 0 && min_data_coverage <= 1,
                 "tracker.min_data_coverage must be in [0, 1]");
@@ -129,6 +130,8 @@ void HandTracker::BuildStages() {
   initial_fitter_ = std::make_unique<HandFitter>(
       model_, intrinsics_, InitialFitOptions(options_, options_.initialisation_iterations));
   contacts_ = std::make_unique<ContactDetector>(model_, options_.contacts);
+  grasp_hold_ = std::make_unique<GraspHold>(options_.grasp_hold, options_.contacts.min_bones,
+                                            model_.EndEffectors(), contacts_->fingertip_vertices());
 }
 
 HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) const {
@@ -345,8 +348,10 @@ TrackResult HandTracker::Track(const Frame& frame) {
       if ((p.array() >= low.array()).all() && (p.array() <= high.array()).all()) near.push_back(p);
     }
     const PointKdTree object(std::move(near));
-    result.contacts = contacts_->Detect(vertices, object);
-    if (!previous_vertices_.empty()) {
+    result.contacts = grasp_hold_->Update(contacts_->Detect(vertices, object), vertices,
+                                          pose_.cam_from_root, object);
+    // A pose found anew (a search) is not the previous one moved: no pairs across it.
+    if (!previous_vertices_.empty() && result.status == TrackStatus::kTracked) {
       for (int v : result.contacts.vertices) {
         if (std::binary_search(previous_contact_vertices_.begin(), previous_contact_vertices_.end(),
                                v)) {
@@ -355,6 +360,9 @@ TrackResult HandTracker::Track(const Frame& frame) {
         }
       }
     }
+  }
+  if (result.contacts.bones.empty() || result.status != TrackStatus::kTracked) {
+    grasp_hold_->Release();
   }
   result.contacts_ms = MillisecondsSince(stage);
   previous_vertices_ = vertices;

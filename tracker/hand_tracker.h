@@ -12,6 +12,7 @@
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
 #include "tracker/contacts.h"
+#include "tracker/grasp_hold.h"
 #include "tracker/hand_fit.h"
 #include "tracker/hand_model.h"
 #include "tracker/hand_pose.h"
@@ -25,6 +26,7 @@ struct TrackerOptions {
   SegmentationOptions segmentation;
   HandFitOptions fit;
   ContactOptions contacts;
+  GraspHoldOptions grasp_hold;
   /// A frame needs this many hand points to be fitted; with fewer it is skipped (no hand).
   int min_hand_points = 150;
   /// A fit with fewer of the hand's points within 10 mm of the model than this has diverged
@@ -192,6 +194,7 @@ class HandTracker {
   std::unique_ptr<HandFitter> coarse_fitter_;
   std::unique_ptr<HandFitter> initial_fitter_;
   std::unique_ptr<ContactDetector> contacts_;
+  std::unique_ptr<GraspHold> grasp_hold_;
   std::vector<std::unique_ptr<ScaleCandidate>> scale_candidates_;
   int scale_frames_done_ = 0;
   bool scale_at_bound_ = false;

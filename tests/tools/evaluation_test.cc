@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -14,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.h"
 #include "core/mesh_io.h"
+#include "sensor/tum_directory.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
 
@@ -29,7 +32,6 @@ class EvaluationTest : public ::testing::Test {
     options.scripted.frames = 60;
     options.last_frame = 19;
     options.write_oni = false;
-    options.write_tum = false;
     synth::GenerateSequence(options, dir_->path() / "seq");
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -111,6 +113,7 @@ TEST_F(EvaluationTest, ContactUseIsCountedAgainstTheTruesGraspsAndDistances) {
   std::string line;
   std::getline(csv, line);
   int grasps = 0, far = 0;
+  std::array<int, 5> finger_far{};
   std::vector<bool> far_frames;
   while (std::getline(csv, line)) {
     std::vector<double> fields;
@@ -123,19 +126,25 @@ TEST_F(EvaluationTest, ContactUseIsCountedAgainstTheTruesGraspsAndDistances) {
       touching += fields[2 + f] > 0.5, nearest = std::min(nearest, fields[7 + f]);
     grasps += touching >= 2;
     far += nearest > 1.0;
+    for (int f = 0; f < 5; ++f) finger_far[f] += fields[7 + f] > 1.0;
     far_frames.push_back(nearest > 1.0);
   }
   ASSERT_EQ(far_frames.size(), truth.size());
   ASSERT_GT(grasps, 5);
   ASSERT_GT(far, 0);
 
-  std::vector<FrameContactUse> none, all, near_only;
+  // The finger farthest from the ball most often: frames whose contacts are that finger alone
+  // are judged by its distance alone.
+  const int finger =
+      static_cast<int>(std::max_element(finger_far.begin(), finger_far.end()) - finger_far.begin());
+  std::vector<FrameContactUse> none, all, near_only, one_finger;
   for (size_t k = 0; k < truth.size(); ++k) {
-    none.push_back({truth[k].time_s, false});
-    all.push_back({truth[k].time_s, true});
-    near_only.push_back({truth[k].time_s, !far_frames[k]});
+    none.push_back({truth[k].time_s, false, {}});
+    all.push_back({truth[k].time_s, true, {}});
+    one_finger.push_back({truth[k].time_s, true, {finger}});
+    near_only.push_back({truth[k].time_s, !far_frames[k], {}});
   }
-  all.push_back({truth.back().time_s + 10.0, true});  // No such frame in the truth: ignored.
+  all.push_back({truth.back().time_s + 10.0, true, {}});  // No such frame in the truth: ignored.
   const ContactUse unused = CompareContactUse(Gt(), none, 1.0);
   EXPECT_EQ(unused.grasp_frames, grasps);
   EXPECT_EQ(unused.used_in_grasp, 0);
@@ -149,6 +158,41 @@ TEST_F(EvaluationTest, ContactUseIsCountedAgainstTheTruesGraspsAndDistances) {
   EXPECT_NEAR(every.false_share, static_cast<double>(far) / truth.size(), 1e-12);
   EXPECT_EQ(CompareContactUse(Gt(), near_only, 1.0).false_frames, 0);
   EXPECT_LE(CompareContactUse(Gt(), all).false_frames, far);  // 3 mm: fewer are that far.
+  ASSERT_GT(finger_far[finger], far);
+  EXPECT_EQ(CompareContactUse(Gt(), one_finger, 1.0).false_frames, finger_far[finger]);
+}
+
+TEST_F(EvaluationTest, TheShownSurfaceGrowsWithTheFramesThatShowIt) {
+  sensor::TumDirectorySource source(dir_->path() / "seq" / "tum");
+  source.Start();
+  std::vector<std::shared_ptr<const Frame>> frames;
+  for (auto read = source.Next(std::chrono::milliseconds(0));
+       read.status == sensor::SourceStatus::kFrame;
+       read = source.Next(std::chrono::milliseconds(0)))
+    frames.push_back(read.frame);
+  ASSERT_EQ(frames.size(), 20u);
+
+  ShownSurface none(Gt(), source.Intrinsics());
+  EXPECT_EQ(none.Share(), 0.0);
+  // A frame the truth does not have shows nothing.
+  Frame stranger = *frames.front();
+  stranger.depth_timestamp_us += 10'000'000;
+  none.Add(stranger);
+  EXPECT_EQ(none.Share(), 0.0);
+
+  // One view of the ball shows less than half of it; the twenty frames, turning it, more.
+  ShownSurface first(Gt(), source.Intrinsics());
+  first.Add(*frames.front());
+  ShownSurface all(Gt(), source.Intrinsics());
+  for (const auto& frame : frames) all.Add(*frame);
+  EXPECT_GT(first.Share(), 0.1);
+  EXPECT_LT(first.Share(), 0.5);
+  EXPECT_GT(all.Share(), first.Share());
+  EXPECT_LE(all.Share(), 1.0);
+  // Farther tolerance, more of the surface within it.
+  EXPECT_GE(all.Share(5.0), all.Share(2.0));
+
+  EXPECT_THROW(ShownSurface(dir_->path() / "no-such-gt", source.Intrinsics()), ihs::InputError);
 }
 
 TEST_F(EvaluationTest, TheTrueObjectMatchesItselfPlacedByTheTrajectory) {
