@@ -176,7 +176,9 @@ void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& h
                 std::vector<Open3dRunner>& open3d, bool quiet, CaseResult& out) {
   double joint_error_sum = 0, track_ms = 0, mask_ms = 0;
   int frames = 0;
+  eval::ShownSurface shown(out.gt_dir, scan.intrinsics());
   scan.Run(hand, [&](app::FramePacket& packet) {
+    shown.Add(*packet.frame);
     track_ms += packet.track.milliseconds;
     mask_ms += packet.mask_ms;
     const std::int64_t index = packet.frame->index;
@@ -197,6 +199,7 @@ void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& h
     if (!quiet && frames % 200 == 0)
       std::fprintf(stderr, "inhandscan-bench: %s frame %d\n", c.name.c_str(), frames);
   });
+  out.shown_share = shown.Share();
   out.joint_error_mm = out.tracked_frames ? joint_error_sum / out.tracked_frames : 0;
   out.track_ms = track_ms / frames;
   out.mask_ms = mask_ms / frames;

@@ -94,6 +94,9 @@ struct CaseResult {
   double joint_error_mm = 0;
   int tracked_frames = 0;
   double track_ms = 0, mask_ms = 0;
+  /// The share of the true surface the recording showed at all (eval::ShownSurface): the
+  /// completeness perfect registration would reach.
+  double shown_share = 0;
   std::vector<MethodResult> methods;
   /// The whole application (`inhandscan replay`) on the same recording: frames per second,
   /// peak resident memory; 0 when not run.

@@ -312,7 +312,7 @@ struct ReportWriter {
   Csv sweep_csv{{"case", "gamma_t", "pairwise_mean_mm", "pairwise_std_mm", "drift_mean_mm"}, {}};
   Csv turns_csv{
       {"case", "method", "truth_turned_deg", "scan_turned_deg", "rotation_error_final_deg",
-       "drift_mean_mm", "chamfer_mm", "completeness", "volume_error", "lost"},
+       "drift_mean_mm", "chamfer_mm", "completeness", "shown", "volume_error", "lost"},
       {}};
   /// Table 1's absolute dimension errors over the paper sessions, per method: on the seen
   /// surface, and on the watertight mesh (mesh.ply).
@@ -398,13 +398,14 @@ std::vector<std::string> FullTurnRow(const CaseResult& r, const MethodResult& m,
   const double truth = Number(j, "turned_deg", "truth"), scan = Number(j, "turned_deg", "scan");
   const auto lost = LostReason(m);
   const std::string drift = Cell(Number(j, "trajectory_error_mm", "mean"), "%.1f");
-  const std::string surface =
-      Cell(Number(j, "chamfer_mm")) + " / " + Cell(100 * Number(j, "completeness"), "%.0f %%");
+  const std::string surface = Cell(Number(j, "chamfer_mm")) + " / " +
+                              Cell(100 * Number(j, "completeness"), "%.0f %%") + " of " +
+                              Cell(100 * r.shown_share, "%.0f %%");
   csv.rows.push_back({r.bench_case.name, m.method, Cell(truth, "%.1f"), Cell(scan, "%.1f"),
                       Cell(Number(j, "rotation_error_deg", "final"), "%.2f"),
                       Cell(Number(j, "trajectory_error_mm", "mean"), "%.3f"),
                       Cell(Number(j, "chamfer_mm"), "%.3f"),
-                      Cell(Number(j, "completeness"), "%.4f"),
+                      Cell(Number(j, "completeness"), "%.4f"), Cell(r.shown_share, "%.4f"),
                       Cell(Number(j, "volume_error"), "%.4f"), lost ? "1" : "0"});
   return {r.bench_case.name,
           m.method,
@@ -425,7 +426,7 @@ void ReportWriter::FullTurnsTable() {
                   "turned (of the truth's)",
                   "rot. err. at end",
                   "drift mm",
-                  "Chamfer mm / compl.",
+                  "Chamfer mm / compl. of shown",
                   "volume (watertight)"};
   std::string charts;
   for (const CaseResult& r : results) {
@@ -450,7 +451,9 @@ void ReportWriter::FullTurnsTable() {
         "it began, so a method that followed none of it ends near 0° too: read it beside "
         "turned). Drift: the mean distance "
         "of the true object's points from where the method puts them. Chamfer and completeness "
-        "(true surface within 2 mm) on the seen surface; the volume of the watertight mesh "
+        "(true surface within 2 mm) on the seen surface, of the share of the true surface the "
+        "recording showed at all (every frame's object pixels placed by the truth's pose: what "
+        "perfect registration would reach); the volume of the watertight mesh "
         "against the true object's (in brackets the share Poisson made up).\n\n"
      << table.Markdown() << "\n"
      << charts << "\n\n";
