@@ -165,8 +165,6 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
   }
 }
 
-// The scan against the ground truth (printed; returned for stats.json): the paper's measures
-// and the surface's distances, and how the contacts were used where the truth grasps.
 // The fingers of the tracker's contact bones in this frame (what the evaluation judges the
 // frame's contacts by).
 std::vector<int> ContactFingers(const ihs::tracker::HandModel& model,
@@ -178,6 +176,9 @@ std::vector<int> ContactFingers(const ihs::tracker::HandModel& model,
   return fingers;
 }
 
+// The scan against the ground truth (printed; returned for stats.json): the paper's measures
+// and the surface's distances, what the recording showed, and how the contacts were used where
+// the truth grasps.
 nlohmann::json Evaluate(const Args& args, const std::string& object,
                         const ihs::app::ScanRecord& record,
                         const ihs::fusion::MeshingResult& meshes,
