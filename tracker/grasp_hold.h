@@ -4,7 +4,7 @@
 // visible points. As the hand turns the object on, its fingertips go round behind it: the
 // camera no longer sees the surface under them and the fit places them farther off, so the
 // detection ends while the hand still holds and turns the object (on the generator's scripted
-// turns the second half of every grasp: 40 % of the turn, lost). Here a grasp of at least
+// turns the second half of many grasps: 20-40 % of the turn, lost). Here a grasp of at least
 // ContactOptions::min_bones fingertips holds while the hand keeps its shape: each held
 // fingertip stays within `max_shape_change_mm`, in the hand's own frame, of where it was when
 // last detected touching, and within `max_reach_mm` of the object's points. A hand that opens
