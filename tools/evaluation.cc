@@ -344,20 +344,39 @@ ShownSurface::ShownSurface(const fs::path& gt_dir, const CameraIntrinsics& intri
   }
 }
 
+std::vector<std::uint8_t> TruthObjectPixels(const fs::path& gt_dir, std::int64_t index, int width,
+                                            int height) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(index));
+  const cv::Mat labels = cv::imread((gt_dir / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
+  if (labels.cols != width || labels.rows != height || !labels.isContinuous()) return {};
+  std::vector<std::uint8_t> object(labels.total());
+  for (size_t i = 0; i < object.size(); ++i) object[i] = labels.data[i] == render::kObject;
+  return object;
+}
+
 void ShownSurface::Add(const Frame& frame) {
   const StampedPose* pose = FindPose(truth_, frame.depth_timestamp_us * 1e-6);
   if (!pose) return;
-  char name[32];
-  std::snprintf(name, sizeof name, "%06d.png", static_cast<int>(pose - truth_.data()));
-  const cv::Mat labels = cv::imread((gt_dir_ / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
-  if (labels.cols != frame.width || labels.rows != frame.height) {
-    throw InputError((gt_dir_ / "labels" / name).string() + ": missing or not the frame's size");
+  const std::int64_t index = pose - truth_.data();
+  const std::vector<std::uint8_t> object =
+      TruthObjectPixels(gt_dir_, index, frame.width, frame.height);
+  if (object.empty()) {
+    throw InputError((gt_dir_ / "labels").string() + ": frame " + std::to_string(index) +
+                     "'s labels are missing or not the frame's size");
   }
+  Add(frame, object);
+}
+
+void ShownSurface::Add(const Frame& frame, const std::vector<std::uint8_t>& object_pixels) {
+  const StampedPose* pose = FindPose(truth_, frame.depth_timestamp_us * 1e-6);
+  if (!pose || object_pixels.size() != frame.depth_mm.size()) return;
   const Rigid3 object_from_cam = pose->transform.Inverse();
   for (int v = 0; v < frame.height; ++v) {
     for (int u = 0; u < frame.width; ++u) {
-      const std::uint16_t depth = frame.depth_mm[static_cast<size_t>(v) * frame.width + u];
-      if (depth == 0 || labels.at<std::uint8_t>(v, u) != render::kObject) continue;
+      const size_t pixel = static_cast<size_t>(v) * frame.width + u;
+      const std::uint16_t depth = frame.depth_mm[pixel];
+      if (depth == 0 || !object_pixels[pixel]) continue;
       const Eigen::Vector3d p = object_from_cam * intrinsics_.BackProject(u, v, depth);
       // A millimetre cube's key (the object lies within ±1 m of its origin).
       const Eigen::Array3i cell = (p.array().floor() + 1024).cast<int>().min(2047).max(0);

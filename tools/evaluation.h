@@ -117,6 +117,11 @@ struct ContactUse {
 ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
                              const std::vector<FrameContactUse>& frames, double false_mm = 3.0);
 
+/// The pixels gt/labels/<index>.png (the generator's labels) marks as the object, row-major,
+/// 1 where it is; empty when the file is missing or not `width` × `height`.
+std::vector<std::uint8_t> TruthObjectPixels(const std::filesystem::path& gt_dir, std::int64_t index,
+                                            int width, int height);
+
 /// What a recording showed of the object at all: every frame's object pixels (gt/labels/, the
 /// generator's) back-projected from the frame's own depth and placed in the truth's object frame
 /// by the truth's pose. The share of the true surface within `within_mm` of those points is the
@@ -129,8 +134,10 @@ class ShownSurface {
   ShownSurface(const std::filesystem::path& gt_dir, const CameraIntrinsics& intrinsics);
 
   /// Adds `frame`'s object pixels (its depth timestamp finds the truth's pose and labels; a
-  /// frame the truth does not have adds nothing).
+  /// frame the truth does not have adds nothing). Throws InputError when its labels are missing.
   void Add(const Frame& frame);
+  /// The same with the frame's object pixels already read (TruthObjectPixels).
+  void Add(const Frame& frame, const std::vector<std::uint8_t>& object_pixels);
 
   /// The share of the true surface (gt/object.ply) within `within_mm` of what was shown.
   double Share(double within_mm = 2.0) const;

@@ -193,6 +193,15 @@ TEST_F(EvaluationTest, TheShownSurfaceGrowsWithTheFramesThatShowIt) {
   EXPECT_GE(all.Share(5.0), all.Share(2.0));
 
   EXPECT_THROW(ShownSurface(dir_->path() / "no-such-gt", source.Intrinsics()), ihs::InputError);
+
+  // The labels read alone: the first frame's ball, none for a frame the truth does not have
+  // or at another size.
+  const Frame& one = *frames.front();
+  const std::vector<std::uint8_t> object = TruthObjectPixels(Gt(), 0, one.width, one.height);
+  ASSERT_EQ(object.size(), one.depth_mm.size());
+  EXPECT_GT(std::count(object.begin(), object.end(), 1), 100);
+  EXPECT_TRUE(TruthObjectPixels(Gt(), 999, one.width, one.height).empty());
+  EXPECT_TRUE(TruthObjectPixels(Gt(), 0, one.width / 2, one.height).empty());
 }
 
 TEST_F(EvaluationTest, TheTrueObjectMatchesItselfPlacedByTheTrajectory) {

@@ -5,7 +5,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "app/scan_record.h"
@@ -15,7 +14,6 @@
 #include "core/mesh_io.h"
 #include "core/stopwatch.h"
 #include "fusion/surface_mesh.h"
-#include "render/offscreen_renderer.h"
 #include "tools/bench/open3d_baseline.h"
 #include "tools/evaluation.h"
 #include "tools/synth/objects.h"
@@ -152,23 +150,6 @@ void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const fusion::Mo
   result.watertight = std::move(meshes.watertight);
 }
 
-// The pixels the truth labels as the object (gt/labels/<index>.png), for Open3D's baseline;
-// none when the labels are missing.
-std::vector<std::uint8_t> TruthObjectPixels(const fs::path& gt_dir, const Frame& frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "%06lld.png", static_cast<long long>(frame.index));
-  const cv::Mat labels = cv::imread((gt_dir / "labels" / name).string(), cv::IMREAD_GRAYSCALE);
-  std::vector<std::uint8_t> keep(frame.PixelCount(), 0);
-  if (labels.total() == keep.size() && labels.isContinuous()) {
-    for (size_t i = 0; i < keep.size(); ++i) keep[i] = labels.data[i] == render::kObject;
-  }
-  return keep;
-}
-
-}  // namespace
-
-namespace {
-
 // The frames' pass: the hand tracked once, each method's stage and record on a copy of the
 // packet, Open3D's baselines on the frame with the truth's object pixels.
 void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& hand,
@@ -177,11 +158,16 @@ void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& h
   double joint_error_sum = 0, track_ms = 0, mask_ms = 0;
   int frames = 0;
   eval::ShownSurface shown(out.gt_dir, scan.intrinsics());
+  std::vector<std::uint8_t> no_object;  // For frames without labels.
   scan.Run(hand, [&](app::FramePacket& packet) {
-    shown.Add(*packet.frame);
+    // The truth's object pixels, read once: what the frame showed, and Open3D's masks.
+    const Frame& frame = *packet.frame;
+    const std::vector<std::uint8_t> truth_object =
+        eval::TruthObjectPixels(out.gt_dir, frame.index, frame.width, frame.height);
+    shown.Add(frame, truth_object);
     track_ms += packet.track.milliseconds;
     mask_ms += packet.mask_ms;
-    const std::int64_t index = packet.frame->index;
+    const std::int64_t index = frame.index;
     if (!packet.track.joints_mm.empty() && index < static_cast<std::int64_t>(gt_joints.size())) {
       joint_error_sum +=
           tracker::MeanJointError(packet.track.joints_mm, gt_joints[index].joints_mm);
@@ -191,10 +177,10 @@ void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& h
       app::FramePacket copy = packet;
       app::ScanObject(*runner.stage, *runner.record, copy);
     }
-    if (!open3d.empty()) {
-      const std::vector<std::uint8_t> keep = TruthObjectPixels(out.gt_dir, *packet.frame);
-      for (Open3dRunner& baseline : open3d) baseline.baseline->Process(*packet.frame, keep);
-    }
+    // Without labels the baselines get no object pixels.
+    if (truth_object.empty()) no_object.assign(frame.PixelCount(), 0);
+    const std::vector<std::uint8_t>& keep = truth_object.empty() ? no_object : truth_object;
+    for (Open3dRunner& baseline : open3d) baseline.baseline->Process(frame, keep);
     ++frames;
     if (!quiet && frames % 200 == 0)
       std::fprintf(stderr, "inhandscan-bench: %s frame %d\n", c.name.c_str(), frames);
