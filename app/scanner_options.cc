@@ -243,6 +243,9 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
   r.Add("fusion.use_icp", &u.use_icp, "refine with point-to-plane ICP against the model");
   r.Add("fusion.icp_retry_fraction", &u.icp_retry_fraction,
         "ICP is retried from the previous pose when it pairs fewer than this share of points");
+  r.Add("fusion.predict_moving", &u.predict_moving,
+        "where nothing registers a frame, the object moves on as in the last frame (when the "
+        "surface left no direction free there; off by default)");
   r.Add("fusion.min_object_points", &u.min_object_points, "object points a frame needs");
   r.Add("fusion.max_jump_mm", &u.max_jump_mm,
         "a frame moving the object's centre farther than this is rejected, mm");

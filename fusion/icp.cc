@@ -87,6 +87,7 @@ class Aligner {
   int inliers() const { return inliers_; }
   double rms() const { return rms_; }
   int iterations() const { return iterations_; }
+  int free_directions() const { return free_directions_; }
 
  private:
   // One iteration; returns whether another may follow.
@@ -107,9 +108,9 @@ class Aligner {
   // The Jacobian row of a point `p` moved along `direction` by the twist about the centre.
   Vector6 Row(const Eigen::Vector3d& p, const Eigen::Vector3d& direction) const;
   // The step the (damped) equations ask for.
-  Vector6 Solve(Equations surface, const Equations& anchored) const;
+  Vector6 Solve(Equations surface, const Equations& anchored);
   // The step in the directions the surface constrains, the anchors' in the others.
-  Vector6 SolveConstrained(const Equations& surface, const Equations& anchored) const;
+  Vector6 SolveConstrained(const Equations& surface, const Equations& anchored);
   // Applies `step` (a twist about the centre) to the correction.
   void ApplyStep(const Vector6& step);
 
@@ -135,6 +136,8 @@ class Aligner {
   // Without anchors (or with anchors for them alone), the directions the surface leaves free
   // keep the prediction (IcpOptions::min_constraint_over_noise, anchors_free_directions_only).
   bool keep_free_ = false;
+  // How many directions kept the prediction in the last iteration (-1: not judged).
+  int free_directions_ = -1;
   // What a direction of the motion learns per point pair from the model's normal noise alone.
   double noise_information_ = 0;
 };
@@ -302,7 +305,7 @@ Vector6 Aligner::Row(const Eigen::Vector3d& p, const Eigen::Vector3d& direction)
   return row;
 }
 
-Vector6 Aligner::Solve(Equations surface, const Equations& anchored) const {
+Vector6 Aligner::Solve(Equations surface, const Equations& anchored) {
   // A little (Marquardt) damping keeps directions the data do not constrain at all where the
   // prediction put them.
   surface.matrix.diagonal() *= 1.0 + 1e-4;
@@ -315,7 +318,7 @@ Vector6 Aligner::Solve(Equations surface, const Equations& anchored) const {
   return surface.matrix.ldlt().solve(surface.rhs);
 }
 
-Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anchored) const {
+Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anchored) {
   // Only the directions the surface constrains move; the others keep the prediction, or
   // follow the anchors where they have any.
   const Eigen::SelfAdjointEigenSolver<Matrix6> eigen(surface.matrix);
@@ -331,6 +334,7 @@ Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anc
     const auto direction = eigen.eigenvectors().col(i);
     step += direction * (direction.dot(surface.rhs) / value);
   }
+  free_directions_ = static_cast<int>(free.size());
   if (!free.empty() && !anchors_.empty())
     step += AnchorStep(eigen.eigenvectors(), free, anchored.matrix, anchored.rhs, step);
   return step;
@@ -371,6 +375,7 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   result.iterations = aligner.iterations();
   result.inliers = aligner.inliers();
   result.rms_mm = aligner.rms();
+  result.free_directions = aligner.free_directions();
   // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.
   result.cam_from_volume = aligner.correction().Inverse() * predicted;
   CheckEnoughPairs(needed, points.size(), &result);

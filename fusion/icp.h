@@ -65,6 +65,10 @@ struct IcpResult {
   /// Root mean square point-to-plane distance of the final pairs, mm.
   double rms_mm = 0;
   int iterations = 0;
+  /// How many directions of the motion the surface left free and kept at the prediction
+  /// (IcpOptions::min_constraint_over_noise) in the last iteration: a ball's 3, a bottle's 1;
+  /// -1 where that was not judged (anchors joined every direction, or the rule is off).
+  int free_directions = -1;
 };
 
 /// A point of the current frame (camera frame, mm) that must land at `target`, where the

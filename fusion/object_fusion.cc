@@ -206,12 +206,15 @@ void ObjectFusion::Start(const FusionInput& input, const ObjectPixels& object,
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const auto& p : object.points) centre += p.cast<double>();
   centre /= static_cast<double>(object.points.size());
+  last_step_ = Rigid3();
+  surface_left_free_ = true;
   Integrate(input, object, Rigid3::Translation(centre), result);
   started_ = true;
 }
 
 void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& object,
                              const Rigid3& pose, FusionResult* result) {
+  if (started_) last_step_ = pose * cam_from_object_.Inverse();
   cam_from_object_ = pose;
   result->cam_from_object = pose;
   const auto integrate_start = SteadyClock::now();
@@ -237,7 +240,11 @@ Rigid3 ObjectFusion::Register(const FusionInput& input, std::vector<PointMatch>*
   correspondences.sets.push_back({"contacts", MatchKind::kContact, *contacts});
   result->pairwise = RegisterPair(correspondences, options_.pairwise);
   result->pairwise_ms = MillisecondsSince(pairwise_start);
-  if (result->pairwise.ok) pose = result->pairwise.current_from_previous * cam_from_object_;
+  if (result->pairwise.ok) {
+    pose = result->pairwise.current_from_previous * cam_from_object_;
+  } else if (options_.predict_moving && !surface_left_free_) {
+    pose = last_step_ * cam_from_object_;
+  }
   return pose;
 }
 
@@ -261,6 +268,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     }
   }
   if (result->icp.ok) {
+    surface_left_free_ = result->icp.free_directions != 0;
     *pose = result->icp.cam_from_volume;
     return true;
   }

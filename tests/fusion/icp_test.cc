@@ -190,9 +190,11 @@ TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
     // 3.7° (the model's flaws decide), keeping the free ones turns it by 0.02°.
     EXPECT_LT(shift, 0.3);
     if (ratio > 0) {
+      EXPECT_EQ(result.free_directions, 3) << "a ball's three turns";
       EXPECT_LT(turn, 0.2);
     } else {
       EXPECT_GT(turn, 1.0) << "the free turns were not free: the test shows nothing";
+      EXPECT_EQ(result.free_directions, -1) << "not judged with the rule off";
     }
   }
 

@@ -196,6 +196,64 @@ TEST(ObjectFusionTest, NoisyContactsWeighLessInIcp) {
   EXPECT_LT(adaptive.pose_error_mm, 0.5 * fixed_share.pose_error_mm);
 }
 
+// The worst pose error (mm, at the ellipsoid's extreme points) of ICP alone on an ellipsoid
+// turned `degrees_per_frame` about a tilted axis for `frames` frames, and in how many frames
+// ICP left a direction free.
+std::pair<double, int> FastTurnWithIcpAlone(double degrees_per_frame, int frames,
+                                            const FusionOptions& options) {
+  const Eigen::Vector3d axes(45, 30, 18);
+  const auto truth = [&](int i) {
+    return Rigid3::Translation({5, -10, 600}) *
+           Rigid3::FromAxisAngle(Eigen::Vector3d(0.3, 1, 0.2), i * degrees_per_frame * M_PI / 180) *
+           Rigid3::FromAxisAngle({1, 0, 0}, 0.3);
+  };
+  ObjectFusion fusion(kIntrinsics, options);
+  Rigid3 object_from_volume;
+  double worst = 0;
+  int left_free = 0;
+  for (int i = 0; i < frames; ++i) {
+    const Frame frame = test::RenderEllipsoid(kIntrinsics, truth(i), axes);
+    std::vector<std::uint8_t> mask(frame.depth_mm.size());
+    for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+    const FusionResult result = fusion.Fuse({&frame, &mask, {}});
+    if (i == 0) object_from_volume = truth(0).Inverse() * result.cam_from_object;
+    left_free += result.icp.free_directions > 0 ? 1 : 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      p[axis] = axes[axis];
+      const Eigen::Vector3d in_volume = object_from_volume.Inverse() * p;
+      worst = std::max(
+          worst,
+          (result.cam_from_object * in_volume - truth(i) * object_from_volume * in_volume).norm());
+    }
+  }
+  return {worst, left_free};
+}
+
+TEST(ObjectFusionTest, AFastTurnNothingRegistersIsPredictedFromTheLastMotion) {
+  // No features, no contacts: only ICP, from the predicted pose. Standing still as the
+  // prediction, a turn of 10° a frame leaves ICP too far to come back; moving on as in the last
+  // frame, it starts near the truth. At 4° a frame both follow.
+  FusionOptions moving_on;
+  moving_on.predict_moving = true;
+  for (const double rate : {4.0, 10.0}) {
+    const auto [moving, moving_free] = FastTurnWithIcpAlone(rate, 24, moving_on);
+    const auto [standing, standing_free] = FastTurnWithIcpAlone(rate, 24, {});
+    std::printf(
+        "%.0f° a frame: worst pose error %.2f mm moving on (%d frames with a free direction), "
+        "%.2f mm standing still\n",
+        rate, moving, moving_free, standing);
+    // Measured: 1.31 / 1.31 mm at 4°, 3.92 / 8.05 mm at 10°.
+    if (rate < 5) {
+      EXPECT_NEAR(moving, standing, 0.3);
+      EXPECT_LT(moving, 2.0);
+    } else {
+      EXPECT_LT(moving, 5.0);
+      EXPECT_LT(moving, 0.6 * standing);
+    }
+  }
+}
+
 TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   const Eigen::Vector3d axes(45, 30, 18);
   ObjectFusion fusion(kIntrinsics);
