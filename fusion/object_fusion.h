@@ -46,7 +46,7 @@ struct FusionOptions {
   /// object is predicted to move on as between the last two fused frames (constant velocity)
   /// rather than to stand still — only when the last frame's ICP left no direction free (where
   /// it did, a ball's spin or a bottle's about its axis, ICP keeps that direction at the
-  /// prediction and a ball would spin on by itself). Off: measured on nine scripted box and
+  /// prediction and a ball would spin on by itself). Off: measured on ten scripted box and
   /// cube turns it ends five of them within 0.6 mm where they ended 52-74 mm off, but three
   /// others slide mid-turn where they did not (docs/fusion.md, 2026-11-28).
   bool predict_moving = false;
