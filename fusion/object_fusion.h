@@ -47,7 +47,7 @@ struct FusionOptions {
   /// rather than to stand still — only when the last frame's ICP left no direction free (where
   /// it did, a ball's spin or a bottle's about its axis, ICP keeps that direction at the
   /// prediction and a ball would spin on by itself). Off: measured on ten scripted box and
-  /// cube turns it ends five of them within 0.6 mm where they ended 52-74 mm off, but three
+  /// cube turns it ends four of them within 0.6 mm where they ended 52-74 mm off, but three
   /// others slide mid-turn where they did not (docs/fusion.md, 2026-11-28).
   bool predict_moving = false;
   /// A frame needs this many object points.
