@@ -52,6 +52,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--textured", options.textured,
                "give a lathe object or the cube a colour pattern (default: one uniform colour)");
+  app.add_flag("--empty-hand", options.empty_hand,
+               "the hand makes the motion with nothing in it (the object is not rendered)");
   app.add_option("--motion", options.motion,
                  "scripted, or recorded:DIR (a session folder of the real hand data)")
       ->capture_default_str();

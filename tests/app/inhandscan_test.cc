@@ -166,19 +166,20 @@ TEST(InhandscanTest, LiveWithoutACameraSaysSoWithCodeFour) {
   EXPECT_NE(devices.out.find("OpenNI2"), std::string::npos) << devices.out;
 }
 
-// A scene without a hand ends the same way whichever recording shows it: no frame is fused
-// (the tracker has no hand in any), code 5, one line that says so.
-void ExpectNothingScannedForWantOfAHand(const fs::path& recording, const fs::path& out) {
+// A scene without a hand, or with a hand holding nothing, ends the same way whichever recording
+// shows it: no frame is fused, code 5, one line that says so and names what was missing.
+void ExpectNothingScannedForWantOf(const fs::path& recording, const fs::path& out,
+                                   const std::string& missing) {
   const auto run = RunApp("replay " + recording.string() + " --out " + out.string() +
                           " --set pipeline.preview_every=0 -q");
   EXPECT_EQ(run.exit_code, 5) << run.err;
   EXPECT_NE(run.err.find("nothing was scanned"), std::string::npos) << run.err;
-  EXPECT_NE(run.err.find("no hand ×"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(missing + " ×"), std::string::npos) << run.err;
   EXPECT_EQ(Lines(run.err), 1) << run.err;
   EXPECT_FALSE(fs::exists(out / "mesh.ply"));
 }
 
-TEST(InhandscanTest, RecordingsWithoutAHandScanNothingAndSaySo) {
+TEST(InhandscanTest, RecordingsWithoutAHandOrWithAnEmptyOneScanNothingAndSaySo) {
   test::TempDir dir;
   // A generated ball turning in front of the camera, no hand anywhere.
   sensor::OniWriterOptions options;
@@ -205,14 +206,24 @@ TEST(InhandscanTest, RecordingsWithoutAHandScanNothingAndSaySo) {
       RunApp("replay " + (dir / "bal.oni").string() + " --out " + (dir / "ball").string() + " -q");
   EXPECT_EQ(missing.exit_code, 3) << missing.err;
   EXPECT_EQ(test::ReadFileString(dir / "ball" / "mesh.ply"), "from an earlier scan");
-  ExpectNothingScannedForWantOfAHand(dir / "ball.oni", dir / "ball");
+  ExpectNothingScannedForWantOf(dir / "ball.oni", dir / "ball", "no hand");
   EXPECT_FALSE(fs::exists(dir / "ball" / "preview" / "000030.png"));
   EXPECT_NE(test::ReadFileString(dir / "ball" / "stats.json"), "from an earlier scan");
   EXPECT_TRUE(fs::exists(dir / "ball" / "notes.txt"));  // Not a scan's file: left alone.
+  // A hand grasping and turning nothing: the same answer.
+  synth::SequenceOptions empty;
+  empty.object = "cube";
+  empty.empty_hand = true;
+  empty.scripted.frames = 60;
+  empty.last_frame = 19;
+  empty.write_tum = false;
+  synth::GenerateSequence(empty, dir / "empty");
+  ExpectNothingScannedForWantOf(dir / "empty" / "sequence.oni", dir / "empty-out",
+                                "too few object points");
   // The real Kinect recording of a room.
   const fs::path real = test::KinectRecording();
   if (real.empty()) GTEST_SKIP() << "no shared data: the real recording's case is left out";
-  ExpectNothingScannedForWantOfAHand(real, dir / "room");
+  ExpectNothingScannedForWantOf(real, dir / "room", "no hand");
 }
 
 class InhandscanSignalTest : public ::testing::Test {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/trajectory_io.h"
+#include "render/offscreen_renderer.h"
 #include "sensor/open_input.h"
 #include "tests/source_reading.h"
 #include "tests/test_util.h"
@@ -220,6 +221,32 @@ TEST(SynthSequenceTest, AFrameStepRendersEveryNthFrameOfTheSameMotion) {
   }
   options.frame_step = 0;
   EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
+// The same grasp with nothing in it: the hand's pixels and pose as with the object, no object
+// pixel, no fingertip touching, nothing held.
+TEST(SynthSequenceTest, AnEmptyHandMakesTheSameMotionWithNothingInIt) {
+  SequenceOptions options = ShortSequence();
+  options.sensor = SensorModelOptions::Ideal();
+  SequenceRenderer holding(options);
+  options.empty_hand = true;
+  SequenceRenderer empty(options);
+  int touching = 0;
+  for (int i : {0, 12, 23}) {
+    const RenderedFrame with = holding.Render(i), without = empty.Render(i);
+    touching += with.contact.TouchingCount();
+    const auto count = [](const RenderedFrame& r, std::uint8_t label) {
+      return std::count(r.labels.begin(), r.labels.end(), label);
+    };
+    EXPECT_GT(count(with, render::kObject), 1000) << i;
+    EXPECT_EQ(count(without, render::kObject), 0) << i;
+    // The hand is the same or more of it shows (the object hid part of it).
+    EXPECT_GE(count(without, render::kHand), count(with, render::kHand)) << i;
+    EXPECT_LT((with.joints_mm[20] - without.joints_mm[20]).norm(), 1e-9) << i;
+    EXPECT_EQ(without.contact.TouchingCount(), 0) << i;
+    EXPECT_FALSE(without.held) << i;
+  }
+  EXPECT_GT(touching, 0) << "with the sphere in it, the grasp touches it";
 }
 
 test::CommandResult RunTool(const std::string& arguments) {

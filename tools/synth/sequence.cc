@@ -291,7 +291,8 @@ json ManifestJson(const SequenceRenderer& renderer, const SequenceSummary& summa
         {"height_mm", object.height_mm()},
         {"max_radius_mm", object.max_radius_mm()},
         {"textured", object.textured()},
-        {"volume_mm3", object.mesh().Volume()}}},
+        {"volume_mm3", object.mesh().Volume()},
+        {"rendered", !options.empty_hand}}},
       {"motion", options.motion},
       {"hand", renderer.hand_source()},
       {"hand_scale", options.hand_scale},
@@ -399,7 +400,9 @@ RenderedFrame SequenceRenderer::Render(int i) {
                                      render::kHand};
   const render::RenderItem object_item{&object_mesh_, m.cam_from_object, options_.object_rgb, true,
                                        render::kObject};
-  render::RenderOutput rendering = renderer_->Render({hand_item, object_item});
+  std::vector<render::RenderItem> items = {hand_item};
+  if (!options_.empty_hand) items.push_back(object_item);
+  render::RenderOutput rendering = renderer_->Render(items);
   std::seed_seq seeds{options_.seed, static_cast<std::uint32_t>(i)};
   std::mt19937 rng(seeds);
   out.frame = ApplySensorModel(rendering, options_.intrinsics, options_.sensor, rng);
@@ -411,7 +414,11 @@ RenderedFrame SequenceRenderer::Render(int i) {
   out.cam_from_bone = m.cam_from_bone;
   out.joints_mm = hand_.JointPositions(m.cam_from_bone);
   out.contact = geometry_->Measure(out.posed_hand, object_, m.cam_from_object, options_.touch_mm);
-  out.held = m.held;
+  out.held = m.held && !options_.empty_hand;
+  if (options_.empty_hand) {
+    for (FingertipContact& tip : out.contact.fingertips) tip.touching = false;
+    out.contact.max_penetration_mm = 0;
+  }
   return out;
 }
 

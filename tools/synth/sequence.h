@@ -39,6 +39,10 @@ struct SequenceOptions {
   std::string object = "sphere";
   /// Give a lathe object or the cube a colour pattern; by default it is one uniform colour.
   bool textured = false;
+  /// The hand makes the motion with nothing in it: the object is not rendered, no fingertip
+  /// touches anything and nothing is held (the ground truth keeps the absent object's poses).
+  /// A scanner must end such a recording as it ends one without a hand.
+  bool empty_hand = false;
   /// "scripted", or "recorded:DIR" with DIR a session folder of the real hand data (holding
   /// Model_Hand_R.SKEL and .MOTION).
   std::string motion = "scripted";
