@@ -105,6 +105,9 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (fused.icp_from_previous) entry["icp_from_previous"] = true;
     if (fused.icp.iterations > 0) {
       entry["icp_inliers"] = fused.icp.inliers;
+      entry["icp_first_inliers"] = fused.icp.first_inliers;
+      entry["icp_points"] = fused.icp.points;
+      if (fused.icp.slid) entry["icp_slid"] = true;
       entry["icp_rms_mm"] = fused.icp.rms_mm;
     }
   }

@@ -159,6 +159,9 @@ void AddRegistrationOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
   r.Add("fusion.icp.min_constraint_over_noise", &u.icp.min_constraint_over_noise,
         "without anchors, ICP leaves directions the surface constrains less than this many times "
         "its normals' noise at the prediction (0: solves all)");
+  r.Add("fusion.icp.min_kept_pair_fraction", &u.icp.min_kept_pair_fraction,
+        "ICP ending with fewer than this share of the pairs it started with slid: its "
+        "best-paired iterate is kept (0: off)");
 }
 
 }  // namespace

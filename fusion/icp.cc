@@ -17,6 +17,8 @@ void IcpOptions::Check() const {
                 "icp.min_inlier_fraction must be in [0, 1]");
   IHS_CHECK_ARG(anchor_share >= 0, "icp.anchor_share must be >= 0");
   IHS_CHECK_ARG(min_constraint_over_noise >= 0, "icp.min_constraint_over_noise must be >= 0");
+  IHS_CHECK_ARG(min_kept_pair_fraction >= 0 && min_kept_pair_fraction <= 1,
+                "icp.min_kept_pair_fraction must be in [0, 1]");
 }
 
 namespace {
@@ -80,11 +82,14 @@ class Aligner {
           const CameraIntrinsics& intrinsics, const IcpOptions& options,
           const std::vector<IcpAnchor>& anchors);
 
-  // Runs the Gauss–Newton iterations until they converge, fail or run out.
+  // Runs the Gauss–Newton iterations until they converge, fail or run out; then, if the last
+  // one lost most of the pairs the first had, goes back to the iterate that paired the most.
   void Run();
+  bool slid() const { return slid_; }
 
   const Rigid3& correction() const { return correction_; }
   int inliers() const { return inliers_; }
+  int first_inliers() const { return first_inliers_; }
   double rms() const { return rms_; }
   int iterations() const { return iterations_; }
   int free_directions() const { return free_directions_; }
@@ -125,7 +130,13 @@ class Aligner {
   Rigid3 correction_;
   double rms_ = 0;
   int inliers_ = 0;
+  int first_inliers_ = 0;
   int iterations_ = 0;
+  // The iterate that paired the most points: its correction, pairs and rms.
+  Rigid3 best_correction_;
+  int best_inliers_ = -1;
+  double best_rms_ = 0;
+  bool slid_ = false;
   // The twist is taken about a pivot (first the points' centroid), with the turn scaled by the
   // points' spread about it, so that turns and shifts weigh alike.
   Eigen::Vector3d pivot_;
@@ -167,6 +178,12 @@ void Aligner::Run() {
   for (int iteration = 0; iteration < options_.iterations; ++iteration) {
     if (!Iterate(iteration)) break;
   }
+  if (inliers_ < options_.min_kept_pair_fraction * first_inliers_ && best_inliers_ > inliers_) {
+    correction_ = best_correction_;
+    inliers_ = best_inliers_;
+    rms_ = best_rms_;
+    slid_ = true;
+  }
 }
 
 bool Aligner::Iterate(int iteration) {
@@ -174,6 +191,10 @@ bool Aligner::Iterate(int iteration) {
   const bool find_pivot = keep_free_ && iteration == 0;
   NormalLines lines;
   Equations surface = PairPoints(find_pivot ? &lines : nullptr);
+  if (iteration == 0) first_inliers_ = inliers_;
+  if (inliers_ > best_inliers_) {
+    best_inliers_ = inliers_, best_correction_ = correction_, best_rms_ = rms_;
+  }
   if (find_pivot && inliers_ >= 6) {
     MovePivot(lines, &surface);
     MeasureNormalNoise(&lines.jitter);
@@ -374,6 +395,9 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   IcpResult result;
   result.iterations = aligner.iterations();
   result.inliers = aligner.inliers();
+  result.first_inliers = aligner.first_inliers();
+  result.points = static_cast<int>(points.size());
+  result.slid = aligner.slid();
   result.rms_mm = aligner.rms();
   result.free_directions = aligner.free_directions();
   // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.

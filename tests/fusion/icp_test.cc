@@ -135,6 +135,77 @@ TEST_F(IcpTest, TooFewPairsIsNotTrusted) {
   EXPECT_THROW(AlignToModel(far, model, intrinsics_, truth, bad), std::invalid_argument);
 }
 
+// A flat face 60 mm square, 600 mm in front of the camera, as the model's raycast sees it, and
+// the frame's points on it.
+struct FlatFace {
+  RaycastImage model;
+  std::vector<Eigen::Vector3f> points;
+};
+
+FlatFace MakeFlatFace(const CameraIntrinsics& intrinsics) {
+  FlatFace face;
+  face.model.width = intrinsics.width, face.model.height = intrinsics.height;
+  const size_t pixels = static_cast<size_t>(intrinsics.width) * intrinsics.height;
+  face.model.depth_mm.assign(pixels, 0.0f);
+  face.model.normals.assign(pixels, Eigen::Vector3f::Zero());
+  face.model.colors.assign(pixels, {0, 0, 0});
+  face.model.written = {0, 0, intrinsics.width, intrinsics.height};
+  for (int v = 0; v < intrinsics.height; ++v) {
+    for (int u = 0; u < intrinsics.width; ++u) {
+      const Eigen::Vector3d p = intrinsics.BackProject(u, v, 600);
+      if (std::abs(p.x()) > 30 || std::abs(p.y()) > 30) continue;
+      face.model.depth_mm[static_cast<size_t>(v) * intrinsics.width + u] = 600;
+      face.model.normals[static_cast<size_t>(v) * intrinsics.width + u] = {0, 0, -1};
+      face.points.push_back(p.cast<float>());
+    }
+  }
+  return face;
+}
+
+TEST(IcpSlideTest, AnIcpThatSlidesOffWhatItStartedOnKeepsItsBestPairedIterate) {
+  // A flat face cannot resist a shift along itself: anchors 35 mm off along it (a contact on
+  // the wrong finger) drag ICP off the face, which keeps fewer and fewer pairs. With the guard
+  // (IcpOptions::min_kept_pair_fraction) the iterate that paired the most is kept.
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  const FlatFace face = MakeFlatFace(intrinsics);
+  std::vector<IcpAnchor> anchors;
+  for (int k = 0; k < 6; ++k) {
+    const Eigen::Vector3d p(10 * std::cos(k), 10 * std::sin(k), 600);
+    anchors.push_back({p, p + Eigen::Vector3d(35, 0, 0), 1.0});
+  }
+  IcpOptions off;
+  off.min_kept_pair_fraction = 0;
+  const Rigid3 predicted;
+  const IcpResult slid = AlignToModel(face.points, face.model, intrinsics, predicted, off, anchors);
+  const IcpResult kept =
+      AlignToModel(face.points, face.model, intrinsics, predicted, IcpOptions(), anchors);
+  std::printf(
+      "dragged 35 mm along a face: %.1f mm and %d of %d pairs without the guard, %.1f mm "
+      "and %d with it\n",
+      slid.cam_from_volume.translation().norm(), slid.inliers, slid.first_inliers,
+      kept.cam_from_volume.translation().norm(), kept.inliers);
+  ASSERT_EQ(slid.points, static_cast<int>(face.points.size()));
+  EXPECT_EQ(slid.first_inliers, slid.points);
+  // Unguarded, ICP follows the anchors off the face and still calls that a fit.
+  EXPECT_TRUE(slid.ok) << slid.reason;
+  EXPECT_FALSE(slid.slid);
+  EXPECT_GT(slid.cam_from_volume.translation().norm(), 20);
+  EXPECT_LT(slid.inliers, 0.5 * slid.first_inliers);
+  // Guarded, it stays on the face with every pair.
+  EXPECT_TRUE(kept.ok) << kept.reason;
+  EXPECT_TRUE(kept.slid);
+  EXPECT_LT(kept.cam_from_volume.translation().norm(), 0.01);
+  EXPECT_EQ(kept.inliers, kept.first_inliers);
+  // Where nothing drags it, the guard has nothing to do.
+  const IcpResult still = AlignToModel(face.points, face.model, intrinsics, predicted);
+  EXPECT_FALSE(still.slid);
+  EXPECT_EQ(still.inliers, still.points);
+  IcpOptions bad;
+  bad.min_kept_pair_fraction = 1.5;
+  EXPECT_THROW(AlignToModel(face.points, face.model, intrinsics, predicted, bad),
+               std::invalid_argument);
+}
+
 // Depth noise as a Carmine's at 0.6 m (1.5 mm standard deviation, whole millimetres).
 Frame Noisy(Frame frame, std::mt19937& rng) {
   std::normal_distribution<double> noise(0.0, 1.5);
