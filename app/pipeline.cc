@@ -433,6 +433,7 @@ void Pipeline::ExportLoop() {
                                 {"cut_share", exported.meshes.cut_share},
                                 {"hull_cut_share", exported.meshes.hull_cut_share},
                                 {"hull_revolved", exported.meshes.hull_revolved},
+                                {"hull_box", exported.meshes.hull_box},
                                 {"volume_mm3", exported.meshes.watertight.IsWatertight()
                                                    ? exported.meshes.watertight.Volume()
                                                    : 0.0}}}};

@@ -313,6 +313,9 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
   r.Add("mesh.bound_revolve_max_residual", &m.bound_revolve_max_residual,
         "a seen surface whose sections fit circles within this share of their radius is turned "
         "all round its axis before its hull is taken (its unseen round side is not cut; 0: never)");
+  r.Add("mesh.bound_box_min_face_share", &m.bound_box_min_face_share,
+        "otherwise, a seen surface this much of which faces along three orthogonal directions is "
+        "bounded by its box along them, not its hull (a box's unseen corner is kept; 0: never)");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
 }
 

@@ -305,20 +305,48 @@ TriangleMesh Remesh(const Lattice& lattice, const std::vector<float>& field,
   return mesh;
 }
 
-// The convex hull of `seen`'s vertices, or of their revolution about its axis when `seen` is a
-// body of revolution (`revolved` says which); faces within `merge_mm` of coplanar merged. A seen
-// surface without volume (flat) has no hull, revolved or not.
-ConvexHull SeenHull(const TriangleMesh& seen, double max_residual, double merge_mm,
-                    bool* revolved) {
-  *revolved = false;
+// The eight corners of the box along `axes` (orthonormal columns) that holds `points`.
+std::vector<Eigen::Vector3f> BoxCorners(const std::vector<Eigen::Vector3f>& points,
+                                        const Eigen::Matrix3d& axes) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = -low;
+  for (const Eigen::Vector3f& point : points) {
+    const Eigen::Vector3d along = axes.transpose() * point.cast<double>();
+    low = low.cwiseMin(along), high = high.cwiseMax(along);
+  }
+  std::vector<Eigen::Vector3f> corners;
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d along((k & 1) ? high.x() : low.x(), (k & 2) ? high.y() : low.y(),
+                                (k & 4) ? high.z() : low.z());
+    corners.push_back((axes * along).cast<float>());
+  }
+  return corners;
+}
+
+// The convex hull of `seen`'s vertices; of their revolution about its axis when `seen` is a
+// body of revolution; of the box along its faces when it is a box's (`shape` says which); faces
+// within `merge_mm` of coplanar merged. A seen surface without volume (flat) has no hull.
+ConvexHull SeenHull(const TriangleMesh& seen, const ClosureBoundOptions& options, double merge_mm,
+                    HullShape* shape) {
+  *shape = HullShape::kSeen;
   ConvexHull hull = ConvexHull::Of(seen.vertices, merge_mm);
-  if (hull.Empty() || max_residual <= 0) return hull;
-  const RevolutionMeasures round = MeasureRevolution(seen);
-  // At least a few sections: the axis is a line through their centres.
-  if (round.roundness_residual > max_residual || round.profile.size() < 3) return hull;
-  *revolved = true;
-  return ConvexHull::Of(RevolvedEnvelope(seen.vertices, round.axis_point, round.axis, 2.0, 64),
-                        merge_mm);
+  if (hull.Empty()) return hull;
+  if (options.revolve_max_residual > 0) {
+    const RevolutionMeasures round = MeasureRevolution(seen);
+    // At least a few sections: the axis is a line through their centres.
+    if (round.roundness_residual <= options.revolve_max_residual && round.profile.size() >= 3) {
+      *shape = HullShape::kRevolved;
+      return ConvexHull::Of(RevolvedEnvelope(seen.vertices, round.axis_point, round.axis, 2.0, 64),
+                            merge_mm);
+    }
+  }
+  if (options.box_min_face_share > 0) {
+    const BoxMeasures box = MeasureBox(seen);
+    if (box.face_share >= options.box_min_face_share) {
+      *shape = HullShape::kBox;
+      return ConvexHull::Of(BoxCorners(seen.vertices, box.axes), merge_mm);
+    }
+  }
+  return hull;
 }
 
 }  // namespace
@@ -333,9 +361,8 @@ ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
   const float step = static_cast<float>(options.voxel_mm);
   // Faces of the hull within a quarter step of coplanar merge: the lattice cannot place a cut
   // finer, and a noisy surface's hull has a thousand faces rather than a hundred.
-  const ConvexHull hull = options.seen_hull ? SeenHull(seen, options.revolve_max_residual,
-                                                       0.25 * step, &result.hull_revolved)
-                                            : ConvexHull();
+  const ConvexHull hull =
+      options.seen_hull ? SeenHull(seen, options, 0.25 * step, &result.hull_shape) : ConvexHull();
   result.hull_planes = hull.planes();
   const Evidence evidence(seen, free_space, hull, options.keep_seen_mm);
   if (!evidence.Any()) return result;

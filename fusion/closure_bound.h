@@ -28,10 +28,19 @@ struct ClosureBoundOptions {
   /// its axis (RevolvedEnvelope): what was not seen of its round side is not cut, only its
   /// unseen ends (0: never).
   double revolve_max_residual = 0.03;
+  /// Otherwise, when at least this share of the seen surface faces along three orthogonal
+  /// directions (MeasureBox: a box's faces, seen from anywhere, 0.89-0.96; bottles, pins and
+  /// spheres 0.10-0.36), the hull is the box along those directions that holds the seen
+  /// surface: a box seen from one side shows its extent along each of its axes (its faces'
+  /// widths), but not the corner behind it that the plain hull would cut off (0: never).
+  double box_min_face_share = 0.8;
   /// Pieces with fewer faces than this share of the largest one's are dropped (a cut may leave
   /// crumbs).
   double min_component_fraction = 0.05;
 };
+
+/// Of what the closure's hull was taken (ClosureBoundOptions).
+enum class HullShape { kSeen, kRevolved, kBox };
 
 /// What BoundClosure did.
 struct ClosureBound {
@@ -46,8 +55,8 @@ struct ClosureBound {
   double hull_share = 0;
   /// Planes of the seen surface's hull (0: no hull: off, or a seen surface without volume).
   int hull_planes = 0;
-  /// Whether the hull was that of the seen surface's revolution about its axis.
-  bool hull_revolved = false;
+  /// The seen surface's own hull, its revolution's about its axis or its box's.
+  HullShape hull_shape = HullShape::kSeen;
 };
 
 /// `closed` (watertight, object frame, mm) without the space `free_space` saw empty, except

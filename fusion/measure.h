@@ -48,6 +48,22 @@ struct RevolutionMeasures {
 /// non-positive `slice_mm`.
 RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm = 2.0);
 
+/// How much of a surface is a box's: three orthogonal directions and the share of the surface
+/// whose normals lie along one of them (either way).
+struct BoxMeasures {
+  /// Orthonormal columns: the direction most of the surface faces (either way), then the one
+  /// most of the rest faces across it, then their cross product.
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  /// Share of the surface's area within the tolerance of ±axes (1 for a box seen anywhere, about
+  /// 0.3 or less for a sphere or a bottle's side).
+  double face_share = 0;
+};
+
+/// Measures `mesh` as a box: the directions its faces' normals gather around (within
+/// `tolerance_deg`; about 200 faces' normals are the candidates, the best refined to the
+/// area-weighted mean of the normals near it). Empty meshes give a share of 0.
+BoxMeasures MeasureBox(const TriangleMesh& mesh, double tolerance_deg = 15.0);
+
 /// How well a scanned surface matches the true one (both in the same frame, mm).
 struct SurfaceComparison {
   /// Mean distance from the scan's surface to the truth's (accuracy), from the truth's to the

@@ -106,6 +106,9 @@ void MeshingOptions::Check() const {
   IHS_CHECK_ARG(
       bound_revolve_max_residual >= 0 && bound_revolve_max_residual <= 1,
       "meshing.bound_revolve_max_residual must be in [0, 1], got " << bound_revolve_max_residual);
+  IHS_CHECK_ARG(
+      bound_box_min_face_share >= 0 && bound_box_min_face_share <= 1,
+      "meshing.bound_box_min_face_share must be in [0, 1], got " << bound_box_min_face_share);
 }
 
 TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction) {
@@ -320,13 +323,15 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
       bound_options.keep_seen_mm = options.bound_keep_seen_mm;
       bound_options.seen_hull = options.bound_by_seen_hull;
       bound_options.revolve_max_residual = options.bound_revolve_max_residual;
+      bound_options.box_min_face_share = options.bound_box_min_face_share;
       bound_options.min_component_fraction = options.min_component_fraction;
       ClosureBound bound = BoundClosure(result.watertight, result.smoothed,
                                         has_views ? *free_space : FreeSpace(), bound_options);
       result.watertight = std::move(bound.mesh);
       result.cut_share = bound.removed_share;
       result.hull_cut_share = bound.hull_share;
-      result.hull_revolved = bound.hull_revolved;
+      result.hull_revolved = bound.hull_shape == HullShape::kRevolved;
+      result.hull_box = bound.hull_shape == HullShape::kBox;
       result.bound_ms = MillisecondsSince(start);
     }
     result.unseen_share = UnseenShare(result.watertight, result.smoothed);

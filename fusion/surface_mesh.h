@@ -50,6 +50,11 @@ struct MeshingOptions {
   /// of a round object is left to Poisson (the plain hull cut it along a flat chord). 0: the plain
   /// hull.
   double bound_revolve_max_residual = 0.03;
+  /// Otherwise, when at least this share of the seen surface faces along three orthogonal
+  /// directions (a box's faces: 0.89-0.96 on the boxes and cubes scanned; 0.10-0.36 on bottles,
+  /// pins and spheres), the hull is the box along them that holds the seen surface: a box seen
+  /// from one side keeps the corner behind it that the plain hull cut off. 0: never.
+  double bound_box_min_face_share = 0.8;
   /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).
   bool color = true;
 
@@ -95,6 +100,8 @@ struct MeshingResult {
   double hull_cut_share = 0;
   /// Whether the hull was the seen surface's revolution about its axis (a body of revolution).
   bool hull_revolved = false;
+  /// Whether the hull was the box along the seen surface's faces (a box seen in part).
+  bool hull_box = false;
   /// Pairs of `watertight`'s faces that cross (FindSelfIntersections): Poisson can fold its
   /// surface through itself, and such a mesh is closed and manifold but not watertight.
   std::int64_t self_intersections = 0;

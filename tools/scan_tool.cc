@@ -119,6 +119,7 @@ nlohmann::json MeshSummary(const ihs::fusion::MeshingResult& meshes, double expo
             {"cut_share", meshes.cut_share},
             {"hull_cut_share", meshes.hull_cut_share},
             {"hull_revolved", meshes.hull_revolved},
+            {"hull_box", meshes.hull_box},
             {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
 }
 
@@ -161,7 +162,10 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
         "closure: %.1f %% of Poisson's volume cut away where the views saw empty space "
         "(%.1f %%) or beyond the seen surface's convex hull%s (%.1f %%)\n",
         100 * meshes.cut_share, 100 * (meshes.cut_share - meshes.hull_cut_share),
-        meshes.hull_revolved ? " (turned all round its axis)" : "", 100 * meshes.hull_cut_share);
+        meshes.hull_revolved ? " (turned all round its axis)"
+        : meshes.hull_box    ? " (the box along its faces)"
+                             : "",
+        100 * meshes.hull_cut_share);
   }
 }
 

@@ -6,9 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <utility>
 #include <vector>
 
@@ -160,7 +162,7 @@ TEST(ClosureBoundTest, ABulgePastTheSeenRimIsCutFlatAtTheRimsPlane) {
   EXPECT_TRUE(mesh.IsWatertight());
   EXPECT_EQ(FindSelfIntersections(mesh, 0).pairs, 0);
   EXPECT_GE(bound.hull_planes, 4);
-  EXPECT_TRUE(bound.hull_revolved);  // A body of revolution.
+  EXPECT_EQ(bound.hull_shape, HullShape::kRevolved);  // A body of revolution.
   // Flat at the rims' planes: nothing past them by more than 1.5 mm (the seen surface is inside
   // its hull: the cut comes right to the rims), and the caps' middles on them.
   int on_caps = 0;
@@ -202,10 +204,13 @@ TriangleMesh WithoutStretch(const TriangleMesh& mesh, double half_angle) {
 
 // A box of edge `edge_mm` centred at the origin, each side a grid of `cells` × `cells` squares
 // (a scan's box has vertices all over its sides, not only at its corners).
-TriangleMesh GridBox(float edge_mm, int cells) {
+// A cube's faces (`faces`: bit 2·axis for the face at −edge/2 along that axis, bit 2·axis + 1
+// for the one at +edge/2; all six by default), a grid of `cells` × `cells` squares each.
+TriangleMesh GridBox(float edge_mm, int cells, int faces = 0x3f) {
   TriangleMesh box;
   for (int axis = 0; axis < 3; ++axis) {
     for (const float sign : {-1.0f, 1.0f}) {
+      if (!(faces & (1 << (2 * axis + (sign > 0 ? 1 : 0))))) continue;
       const int u = (axis + 1) % 3, v = (axis + 2) % 3;
       const auto first = static_cast<std::int32_t>(box.vertices.size());
       for (int j = 0; j <= cells; ++j) {
@@ -239,7 +244,7 @@ TEST(ClosureBoundTest, TheUnseenSideOfARoundObjectIsLeftToTheClosure) {
   const TriangleMesh bulging = test::MakeLathe(Profile(80, cylinder, 15), 64);
   const ClosureBound bound = BoundClosure(bulging, seen, FreeSpace(), {});
   ASSERT_TRUE(bound.changed);
-  EXPECT_TRUE(bound.hull_revolved);
+  EXPECT_EQ(bound.hull_shape, HullShape::kRevolved);
   float reach_x = 0;
   for (const auto& v : bound.mesh.vertices) {
     ASSERT_GT(v.z(), -1.5f) << v.transpose();
@@ -252,22 +257,46 @@ TEST(ClosureBoundTest, TheUnseenSideOfARoundObjectIsLeftToTheClosure) {
   plain.revolve_max_residual = 0;
   const ClosureBound chord = BoundClosure(bulging, seen, FreeSpace(), plain);
   ASSERT_TRUE(chord.changed);
-  EXPECT_FALSE(chord.hull_revolved);
+  EXPECT_NE(chord.hull_shape, HullShape::kRevolved);
   reach_x = 0;
   for (const auto& v : chord.mesh.vertices) reach_x = std::max(reach_x, v.x());
   EXPECT_LT(reach_x, 18.0f);  // The chord: 15 mm, or 16.7 where a face half in the stretch stays.
   EXPECT_LT(chord.mesh.Volume(), 0.95 * bound.mesh.Volume());
 }
 
-TEST(ClosureBoundTest, ABoxIsNotRoundAndGetsThePlainHull) {
+TEST(ClosureBoundTest, ABoxIsNotRoundAndGetsItsBox) {
   // A box seen whole inside a ball 20 mm past its corners: cut back to the box itself.
   const TriangleMesh seen = GridBox(40, 20);
   const ClosureBound bound = BoundClosure(test::MakeUvSphere(55, 32, 64), seen, FreeSpace(), {});
   ASSERT_TRUE(bound.changed);
-  EXPECT_FALSE(bound.hull_revolved);
+  EXPECT_EQ(bound.hull_shape, HullShape::kBox);
   EXPECT_EQ(bound.hull_planes, 6);
   for (const auto& v : bound.mesh.vertices) ASSERT_LT(v.cwiseAbs().maxCoeff(), 21.0f);
   EXPECT_NEAR(bound.mesh.Volume(), 40.0 * 40 * 40, 0.03 * 40 * 40 * 40);
+}
+
+TEST(ClosureBoundTest, ABoxSeenFromOneSideKeepsTheCornerBehindIt) {
+  // Two faces of a turned 40 mm cube seen (its front and its top, sharing an edge), inside a
+  // ball as Poisson's guess. The plain hull of what was seen is the prism between the two faces'
+  // far edges: half the cube. The box along the faces is the whole cube.
+  const Eigen::Matrix3f turn =
+      Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 0.5).normalized()).toRotationMatrix();
+  TriangleMesh seen = GridBox(40, 20, (1 << 5) | (1 << 3));
+  for (auto& v : seen.vertices) v = turn * v;
+  const TriangleMesh ball = test::MakeUvSphere(55, 32, 64);
+  const ClosureBound box = BoundClosure(ball, seen, FreeSpace(), {});
+  ClosureBoundOptions plain;
+  plain.box_min_face_share = 0;
+  const ClosureBound hull = BoundClosure(ball, seen, FreeSpace(), plain);
+  std::printf("two faces of a 64 000 mm³ cube: %.0f mm³ in their box, %.0f in their hull\n",
+              box.mesh.Volume(), hull.mesh.Volume());
+  ASSERT_TRUE(box.changed && hull.changed);
+  EXPECT_EQ(box.hull_shape, HullShape::kBox);
+  EXPECT_EQ(hull.hull_shape, HullShape::kSeen);
+  EXPECT_NEAR(box.mesh.Volume(), 40.0 * 40 * 40, 0.04 * 40 * 40 * 40);
+  EXPECT_NEAR(hull.mesh.Volume(), 0.5 * 40 * 40 * 40, 0.04 * 40 * 40 * 40);
+  for (const auto& v : box.mesh.vertices)
+    ASSERT_LT((turn.transpose() * v).cwiseAbs().maxCoeff(), 21.0f);
 }
 
 TEST(ClosureBoundTest, AConcaveSeenSurfaceIsInsideItsHullAndStays) {

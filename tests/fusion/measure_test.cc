@@ -147,6 +147,30 @@ TEST(MeasureTest, ASmallBottleSeenFromBelowOnOneSideMeasuresItsHeight) {
   EXPECT_NEAR(m.widest_diameter_mm, 52, 0.5);
 }
 
+TEST(MeasureTest, ABoxFacesAlongThreeDirectionsARoundObjectDoesNot) {
+  // The generator's 60 x 45 x 90 mm box, turned, whole and as the three faces seen from one
+  // corner: its faces along its own axes; the paper's round objects nowhere near.
+  TriangleMesh box = synth::MakeTexturedBox({60, 45, 90});
+  const Eigen::Matrix3f turn =
+      Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()).toRotationMatrix();
+  for (auto& v : box.vertices) v = turn * v;
+  const TriangleMesh corner = KeepFaces(box, [&](const Eigen::Vector3d&, const Eigen::Vector3d& n) {
+    return (turn.cast<double>().transpose() * n).minCoeff() > -1e-9;  // Faces toward +x, +y, +z.
+  });
+  for (const TriangleMesh* mesh : {static_cast<const TriangleMesh*>(&box), &corner}) {
+    const BoxMeasures m = MeasureBox(*mesh);
+    EXPECT_GT(m.face_share, 0.99);
+    // Each found axis is one of the box's.
+    const Eigen::Matrix3d along = turn.cast<double>().transpose() * m.axes;
+    for (int k = 0; k < 3; ++k) EXPECT_GT(along.col(k).cwiseAbs().maxCoeff(), 0.999) << k;
+    EXPECT_NEAR(std::abs(m.axes.determinant()), 1.0, 1e-9);
+  }
+  for (const char* name : {"sphere", "water-bottle", "small-bottle", "bowling-pin"}) {
+    EXPECT_LT(MeasureBox(PaperObject(name)).face_share, 0.5) << name;
+  }
+  EXPECT_EQ(MeasureBox(TriangleMesh{}).face_share, 0);
+}
+
 TEST(MeasureTest, SurfaceComparisonMeasuresTheGapAndTheCoverage) {
   const TriangleMesh truth = test::MakeUvSphere(35, 64, 128);
   const SurfaceComparison same = CompareSurfaces(truth, truth);
