@@ -234,9 +234,10 @@ FacetNormals FaceNormals(const TriangleMesh& mesh) {
   return out;
 }
 
-// Of the faces' normals within `across_cos` of perpendicular to `across` (all when `across` is
-// zero), the direction the most area faces (either way) within `cos_tolerance`, refined to the
-// area-weighted mean of those normals; zero when there is none.
+// Of the faces whose normals are within the tolerance of perpendicular to `across` (all faces
+// when `across` is zero), the direction the most area faces (either way) within
+// `cos_tolerance`, refined to the area-weighted mean of those normals (in the plane across
+// `across`); zero when there is none.
 Eigen::Vector3d DominantDirection(const FacetNormals& facets, const Eigen::Vector3d& across,
                                   double cos_tolerance) {
   const double max_along = std::sqrt(std::max(0.0, 1.0 - cos_tolerance * cos_tolerance));
