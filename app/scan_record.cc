@@ -107,7 +107,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["icp_inliers"] = fused.icp.inliers;
       entry["icp_first_inliers"] = fused.icp.first_inliers;
       entry["icp_points"] = fused.icp.points;
-      if (fused.icp.slid) entry["icp_slid"] = true;
+      if (fused.icp.slid) entry["icp_slid"] = true, ++icp_slid_frames_;
       entry["icp_rms_mm"] = fused.icp.rms_mm;
     }
   }
@@ -146,6 +146,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"hand_doubtful_frames", doubtful_frames_},
                             {"hand_turned_over_frames", turned_over_frames_},
                             {"held_grasp_frames", held_grasp_frames_},
+                            {"icp_slid_frames", icp_slid_frames_},
                             {"fusion_status_counts", fusion_counts_},
                             {"skip_reasons", skip_reasons_},
                             {"coverage", coverage_},

@@ -137,6 +137,9 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
               count(fusion_counts, "skipped"));
   for (const auto& [reason, n] : record.skip_reasons())
     std::printf("  skipped: %s × %lld\n", reason.c_str(), static_cast<long long>(n));
+  if (const int slid = count(summary, "icp_slid_frames"); slid > 0)
+    std::printf("  ICP slid off what it started on in %d frames: its best-paired iterate kept\n",
+                slid);
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
   std::printf(

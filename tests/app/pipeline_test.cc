@@ -318,10 +318,13 @@ TEST_F(PipelineFaultTest, MalformedAndEmptyFramesAreSkippedWithTheirReasons) {
   // The summary counts the frames whose hand pose was doubtful, as the frames say.
   int doubtful = 0;
   int turned_over = 0;
+  int slid = 0;
   for (const auto& frame : stats["frames"]) {
     doubtful += frame.value("track_doubtful", false);
     turned_over += frame.value("track_turned_over", false);
+    slid += frame.value("icp_slid", false);
   }
+  EXPECT_EQ(stats["summary"]["icp_slid_frames"], slid);
   EXPECT_EQ(stats["summary"]["hand_doubtful_frames"], doubtful);
   EXPECT_EQ(stats["summary"]["hand_turned_over_frames"], turned_over);
   EXPECT_FALSE(ReadMesh(out / "mesh.ply").Empty());
