@@ -117,6 +117,20 @@ void AddGraspHoldOptions(OptionRegistry& r, tracker::GraspHoldOptions* hold) {
         "frames in a row a grasp is held without being detected at most");
 }
 
+void AddGraspSideOptions(OptionRegistry& r, tracker::GraspSideOptions* side) {
+  tracker::GraspSideOptions& g = *side;
+  r.Add("tracker.grasp_side.weight", &g.weight,
+        "score penalty per unit of cosine a palm turns away from the held object beyond "
+        "min_cosine (0: off)");
+  r.Add("tracker.grasp_side.min_cosine", &g.min_cosine,
+        "cosine between the palm's normal and the direction to the object's middle below which a "
+        "pose is penalised");
+  r.Add("tracker.grasp_side.near_hand_mm", &g.near_hand_mm,
+        "object points within this distance of the hand points' centroid make the held object, mm");
+  r.Add("tracker.grasp_side.min_object_points", &g.min_object_points,
+        "fewer object points near the hand: no object seen, no penalty");
+}
+
 // The fusion's sub-groups: the TSDF volume, and the registration (pairwise and ICP).
 void AddTsdfOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
   fusion::FusionOptions& u = *fusion;
@@ -224,6 +238,7 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
   AddHandFitOptions(r, &t.fit);
   AddContactOptions(r, &t.contacts);
   AddGraspHoldOptions(r, &t.grasp_hold);
+  AddGraspSideOptions(r, &t.grasp_side);
 }
 
 void AddFeatureOptions(OptionRegistry& r, fusion::SiftOptions* sift, fusion::ShotOptions* shot) {

@@ -214,8 +214,8 @@ HandSearch::HandSearch(const HandModel& model, const CameraIntrinsics& intrinsic
 std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f>& hand_points,
                                                const Frame& frame,
                                                const std::vector<HandPose>& articulations,
-                                               const std::vector<HandPose>& tracked,
-                                               int count) const {
+                                               const std::vector<HandPose>& tracked, int count,
+                                               const GraspSide* side, bool right_hand) const {
   std::vector<SearchHypothesis> found;
   if (hand_points.empty() || count <= 0) return found;
   const PointKdTree data_tree(Thinned(hand_points, 6 * options_.sample_points));
@@ -233,6 +233,15 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     int articulation;
     Rigid3 cam_from_model;
     double score;
+  };
+  // The grasp side's penalty of articulation `index` placed at `cam_from_model`.
+  std::vector<PalmAxes> palms;  // Per articulation, in the model's frame.
+  auto side_penalty = [&](int index, const Rigid3& cam_from_model) {
+    if (side == nullptr) return 0.0;
+    const PalmAxes& palm = palms[static_cast<size_t>(index)];
+    const PalmAxes placed{cam_from_model.rotation() * palm.across,
+                          cam_from_model.rotation() * palm.along, cam_from_model * palm.centre};
+    return side->Penalty(placed, right_hand);
   };
   std::vector<Start> starts;
   std::vector<std::unique_ptr<Placement>> placements;
@@ -267,10 +276,12 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     placements.push_back(
         std::make_unique<Placement>(vertices, data_tree, data, frame, intrinsics_, options_));
     poses.push_back(articulation);
+    palms.push_back(
+        PalmAxesOf(model_, model_.JointPositions(ForwardKinematics(model_, articulation))));
     auto add = [&](const Rigid3& start) {
       double score = 0;
       const Rigid3 placed = placements.back()->Place(start, 1, 3, &score);
-      starts.push_back({index, placed, score});
+      starts.push_back({index, placed, score + side_penalty(index, placed)});
     };
     for (const Eigen::Matrix3d& rotation : rotations)
       add(Rigid3(rotation, centre - rotation * model_centre));
@@ -286,6 +297,7 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     hypothesis.pose = poses[starts[k].articulation];
     hypothesis.pose.cam_from_root = placements[starts[k].articulation]->Place(
         starts[k].cam_from_model, options_.placement_iterations, 1, &hypothesis.score);
+    hypothesis.score += side_penalty(starts[k].articulation, hypothesis.pose.cam_from_root);
     found.push_back(std::move(hypothesis));
   }
   const size_t kept = std::min<size_t>(found.size(), count);

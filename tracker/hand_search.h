@@ -12,6 +12,7 @@
 
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
+#include "tracker/grasp_side.h"
 #include "tracker/hand_model.h"
 #include "tracker/hand_pose.h"
 
@@ -50,10 +51,12 @@ class HandSearch {
   /// The `count` best placed hypotheses (best first) for `hand_points` (camera frame, mm) seen
   /// in `frame`, over every articulation in `articulations` and `tracked` in every orientation
   /// (their root poses ignored); each of `tracked` (poses the tracker held) is also placed from
-  /// its own root pose.
+  /// its own root pose. With `side`, a hypothesis whose palm faces away from the held object
+  /// scores worse by GraspSide::Penalty (`right_hand`: the model's side).
   std::vector<SearchHypothesis> Best(const std::vector<Eigen::Vector3f>& hand_points,
                                      const Frame& frame, const std::vector<HandPose>& articulations,
-                                     const std::vector<HandPose>& tracked, int count) const;
+                                     const std::vector<HandPose>& tracked, int count,
+                                     const GraspSide* side = nullptr, bool right_hand = true) const;
 
   const HandSearchOptions& options() const { return options_; }
 

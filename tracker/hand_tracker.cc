@@ -43,6 +43,7 @@ void TrackerOptions::Check() const {
   fit.Check();
   contacts.Check();
   grasp_hold.Check();
+  grasp_side.Check();
   IHS_CHECK_ARG(min_hand_points >= 10, "tracker.min_hand_points must be >= 10");
   IHS_CHECK_ARG(min_data_coverage >= 0 && min_data_coverage <= 1,
                 "tracker.min_data_coverage must be in [0, 1]");
@@ -100,6 +101,7 @@ struct HandTracker::ScaleCandidate {
 HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
                          TrackerOptions options)
     : base_model_(std::move(model)),
+      right_hand_(IsRightHand(base_model_)),
       model_(base_model_),
       intrinsics_(intrinsics),
       options_((options.Check(), std::move(options))),
@@ -199,8 +201,13 @@ void HandTracker::Initialise(const HandPose& pose) {
   has_confident_pose_ = false;
 }
 
+double HandTracker::Score(const HandFitResult& fit, const GraspSide* side) const {
+  return FitScore(fit) + (side != nullptr ? side->Penalty(model_, fit.pose, right_hand_) : 0.0);
+}
+
 HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_points,
-                                  const Frame& frame, const Segmentation* segmentation) const {
+                                  const Frame& frame, const Segmentation* segmentation,
+                                  const GraspSide* side) const {
   // Articulations to place: the open hand and four curls toward a fist, the last confident
   // pose's and the one held now (a grasping hand is far from the open one: from the open hand
   // alone a search after a jump mid-grasp settled 122 mm off with 88 % of the points
@@ -213,25 +220,28 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
   // The best placed hypotheses fitted briefly; the best few of those fitted on.
   std::vector<HandFitResult> coarse;
   for (const SearchHypothesis& hypothesis :
-       search_->Best(hand_points, frame, articulations, tracked, options_.search_candidates))
+       search_->Best(hand_points, frame, articulations, tracked, options_.search_candidates, side,
+                     right_hand_))
     coarse.push_back(coarse_fitter_->Fit(hand_points, &frame, hypothesis.pose, segmentation));
   const size_t kept = std::min<size_t>(coarse.size(), options_.search_refined);
-  std::partial_sort(
-      coarse.begin(), coarse.begin() + kept, coarse.end(),
-      [](const HandFitResult& a, const HandFitResult& b) { return FitScore(a) < FitScore(b); });
+  std::partial_sort(coarse.begin(), coarse.begin() + kept, coarse.end(),
+                    [&](const HandFitResult& a, const HandFitResult& b) {
+                      return Score(a, side) < Score(b, side);
+                    });
   HandFitResult best;
   for (size_t k = 0; k < kept; ++k) {
     HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, coarse[k].pose, segmentation);
-    if (k == 0 || FitScore(fit) < FitScore(best)) best = std::move(fit);
+    if (k == 0 || Score(fit, side) < Score(best, side)) best = std::move(fit);
   }
   return best;
 }
 
 bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points,
-                                  const Frame& frame, TrackResult& result) const {
+                                  const Frame& frame, TrackResult& result,
+                                  const GraspSide* side) const {
   HandFitResult turned = initial_fitter_->Fit(
       hand_points, &frame, TurnedOver(model_, result.fit.pose), &result.segmentation);
-  const double kept = FitScore(result.fit), other = FitScore(turned);
+  const double kept = Score(result.fit, side), other = Score(turned, side);
   spdlog::debug("frame {}: fit scores {:.2f}, turned over {:.2f}", frame.index, kept, other);
   if (other < kept) {
     result.fit = std::move(turned);
@@ -270,8 +280,10 @@ TrackResult HandTracker::Track(const Frame& frame) {
     return finish();
   }
 
+  const std::optional<GraspSide> held = GraspSide::Of(result.segmentation, options_.grasp_side);
+  const GraspSide* side = held ? &*held : nullptr;
   if (!has_pose_) {
-    result.fit = Search(points, frame, &result.segmentation);
+    result.fit = Search(points, frame, &result.segmentation, side);
     result.status = TrackStatus::kInitialised;
   } else {
     HandPose predicted = pose_;
@@ -288,8 +300,8 @@ TrackResult HandTracker::Track(const Frame& frame) {
   if (result.status == TrackStatus::kTracked &&
       doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
     doubtful_in_a_row_ = 0;
-    HandFitResult found = Search(points, frame, &result.segmentation);
-    if (FitScore(found) < FitScore(result.fit)) {
+    HandFitResult found = Search(points, frame, &result.segmentation, side);
+    if (Score(found, side) < Score(result.fit, side)) {
       result.fit = std::move(found);
       result.status = TrackStatus::kInitialised;
     }
@@ -300,7 +312,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
       (result.status == TrackStatus::kInitialised ||
        ++frames_since_flip_check_ >= options_.flip_check_frames)) {
     frames_since_flip_check_ = 0;
-    tie = CheckTurnedOver(points, frame, result);
+    tie = CheckTurnedOver(points, frame, result, side);
   }
   if (result.fit.data_coverage >= options_.search_data_coverage && !tie) {
     confident_pose_ = result.fit.pose;

@@ -13,6 +13,7 @@
 #include "core/frame.h"
 #include "tracker/contacts.h"
 #include "tracker/grasp_hold.h"
+#include "tracker/grasp_side.h"
 #include "tracker/hand_fit.h"
 #include "tracker/hand_model.h"
 #include "tracker/hand_pose.h"
@@ -27,6 +28,10 @@ struct TrackerOptions {
   HandFitOptions fit;
   ContactOptions contacts;
   GraspHoldOptions grasp_hold;
+  /// A pose whose palm faces away from the object seen in the hand explains the frame worse
+  /// (GraspSide): in the search's ranking, the tracked fit's competition with a search, and the
+  /// turned-over check.
+  GraspSideOptions grasp_side;
   /// A frame needs this many hand points to be fitted; with fewer it is skipped (no hand).
   int min_hand_points = 150;
   /// A fit with fewer of the hand's points within 10 mm of the model than this has diverged
@@ -170,11 +175,14 @@ class HandTracker {
   struct ScaleCandidate;
   // The fit from the search's hypotheses that explains the hand best.
   HandFitResult Search(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
-                       const Segmentation* segmentation) const;
+                       const Segmentation* segmentation, const GraspSide* side) const;
+  // How badly `fit` explains the frame (lower is better): FitScore, and the grasp side's
+  // penalty where an object is seen in the hand.
+  double Score(const HandFitResult& fit, const GraspSide* side) const;
   // The fit turned over (TurnedOver), fitted: replaces `result`'s fit when it explains the hand
   // better; returns whether the two tie (within flip_tie_score).
   bool CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
-                       TrackResult& result) const;
+                       TrackResult& result, const GraspSide* side) const;
   // Builds the fitters and the contact detector for model_.
   void BuildStages();
   // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's
@@ -184,6 +192,7 @@ class HandTracker {
   void EstimateScale(const Segmentation& segmentation, const Frame& frame);
 
   const HandModel base_model_;
+  const bool right_hand_;
   HandModel model_;
   double scale_ = 1.0;
   const CameraIntrinsics intrinsics_;
