@@ -5,9 +5,10 @@
 # estimated). Prints per sequence what was drawn, the joint error of the first frame and over
 # all frames, the scale estimate, the doubtful frames, the frames fitted turned over against the
 # truth ("over": palm for back or the thumb's tip nearer the true little fingertip than the true
-# thumb tip; "palm": palm for back) and the ms per frame; then the mean,
-# the median, how many sequences stay within 10 mm and how many are flipped (over > 10
-# frames). Draw new seeds to measure a change on hands it was not developed on.
+# thumb tip; "palm": palm for back) and the ms per frame; then the mean, the median, how many
+# sequences stay within 10 mm, how many are flipped (over > 10 frames) and how many of those
+# palm for back (palm > 10 frames). Draw new seeds to measure a change on hands it was not
+# developed on.
 #   tools/bench_hand_init.sh [SEED] [COUNT] [FRAMES] [WORK_DIR]
 # SEED: default 1000; COUNT: sequences (default 24); FRAMES: frames per sequence from the
 # start of a half turn (default 61). Set IHS_BUILD_DIR to use another build, IHS_TRACK_ARGS for
@@ -67,7 +68,7 @@ work = sys.argv[1]
 print("%-7s %-13s %6s %6s %5s %5s %4s %9s %9s %6s %8s %5s %5s %6s" % (
     "case", "object", "az", "hand", "mm", "tilt", "side", "first mm", "mean mm", "scale",
     "doubtful", "over", "palm", "ms"))
-means, flipped = [], 0
+means, flipped, palm_for_back = [], 0, 0
 for line in open(os.path.join(work, "cases.txt")):
     name, *args = line.split()
     opt = dict(zip(args[0::2], args[1::2]))
@@ -82,6 +83,7 @@ for line in open(os.path.join(work, "cases.txt")):
     means.append(mean)
     over = s.get("turned_over_frames", 0)
     flipped += over > 10
+    palm_for_back += s.get("palm_reversed_frames", 0) > 10
     print("%-7s %-13s %6s %6s %5s %5s %4s %9.1f %9.1f %6.3f %8d %5d %5d %6.1f" % (
         name, opt["--object"], opt["--start-azimuth-deg"], opt["--hand-scale"],
         opt["--distance-mm"], opt["--tilt-deg"], "L" if "--left-hand" in args else "R", first,
@@ -89,7 +91,8 @@ for line in open(os.path.join(work, "cases.txt")):
         s.get("palm_reversed_frames", 0), s["ms_mean"]))
 ok = [m for m in means if m == m]
 print("joint error over %d sequences: mean %.1f mm, median %.1f mm; %d within 10 mm; "
-      "%d flipped (turned over in more than 10 frames)" % (
-    len(ok), statistics.mean(ok), statistics.median(ok), sum(m <= 10 for m in ok), flipped))
+      "%d flipped (turned over in more than 10 frames), %d of them palm for back" % (
+    len(ok), statistics.mean(ok), statistics.median(ok), sum(m <= 10 for m in ok), flipped,
+    palm_for_back))
 PY
 echo "work folder: $work"
