@@ -216,6 +216,11 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
         "rigid ICP iterations placing each search hypothesis on the hand points");
   r.Add("tracker.search.sample_points", &t.search.sample_points,
         "model and hand points used to place and score a search hypothesis");
+  r.Add("tracker.search.grasp_rolls", &t.search.grasp_rolls,
+        "where an object is seen in the hand, starts holding it in the palm, turned about the "
+        "palm's normal in this many steps (0: none)");
+  r.Add("tracker.search.grasp_tilt_deg", &t.search.grasp_tilt_deg,
+        "those starts' palm normal also tilted this much four ways, degrees");
   r.Add("tracker.search.score_cap_mm", &t.search.score_cap_mm,
         "largest distance a search hypothesis's score counts per point, mm");
   r.Add("tracker.search_candidates", &t.search_candidates,

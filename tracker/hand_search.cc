@@ -193,6 +193,40 @@ HandPose TurnedOver(const HandModel& model, const HandPose& pose) {
   return out;
 }
 
+std::vector<Rigid3> GraspStarts(const PalmAxes& palm, bool right_hand,
+                                const Eigen::Vector3d& object, const Eigen::Vector3d& hand,
+                                const HandSearchOptions& options) {
+  std::vector<Rigid3> starts;
+  const Eigen::Vector3d away = hand - object;
+  if (away.norm() < 1e-6) return starts;
+  const Eigen::Vector3d normal_model = ((right_hand ? 1.0 : -1.0) * palm.Normal()).normalized();
+  const Eigen::Vector3d along_model =
+      (palm.along - palm.along.dot(normal_model) * normal_model).normalized();
+  Eigen::Matrix3d model_basis;
+  model_basis << normal_model, along_model, normal_model.cross(along_model);
+  const Eigen::Vector3d u = away.normalized();
+  const Eigen::Vector3d side_a = u.unitOrthogonal(), side_b = u.cross(side_a);
+  const double tilt = options.grasp_tilt_deg * M_PI / 180.0;
+  std::vector<Eigen::Vector3d> directions = {u};
+  for (const Eigen::Vector3d axis :
+       {side_a, Eigen::Vector3d(-side_a), side_b, Eigen::Vector3d(-side_b)})
+    directions.push_back(Eigen::AngleAxisd(tilt, axis) * u);
+  for (const Eigen::Vector3d& direction : directions) {
+    const Eigen::Vector3d normal = -direction;  // The palm faces the object.
+    const Eigen::Vector3d palm_centre = object + away.norm() * direction;
+    const Eigen::Vector3d reference = normal.unitOrthogonal();
+    for (int k = 0; k < options.grasp_rolls; ++k) {
+      const Eigen::Vector3d along =
+          Eigen::AngleAxisd(2 * M_PI * k / options.grasp_rolls, normal) * reference;
+      Eigen::Matrix3d basis;
+      basis << normal, along, normal.cross(along);
+      const Eigen::Matrix3d rotation = basis * model_basis.transpose();
+      starts.emplace_back(rotation, palm_centre - rotation * palm.centre);
+    }
+  }
+  return starts;
+}
+
 void HandSearchOptions::Check() const {
   IHS_CHECK_ARG(directions >= 1 && directions <= 1000,
                 "tracker.search.directions must be in [1, 1000]");
@@ -202,6 +236,10 @@ void HandSearchOptions::Check() const {
   IHS_CHECK_ARG(sample_points >= 10 && sample_points <= 100000,
                 "tracker.search.sample_points must be in [10, 100000]");
   IHS_CHECK_ARG(score_cap_mm > 0, "tracker.search.score_cap_mm must be positive");
+  IHS_CHECK_ARG(grasp_rolls >= 0 && grasp_rolls <= 360,
+                "tracker.search.grasp_rolls must be in [0, 360]");
+  IHS_CHECK_ARG(grasp_tilt_deg >= 0 && grasp_tilt_deg <= 90,
+                "tracker.search.grasp_tilt_deg must be in [0, 90]");
 }
 
 HandSearch::HandSearch(const HandModel& model, const CameraIntrinsics& intrinsics,
@@ -285,6 +323,11 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     };
     for (const Eigen::Matrix3d& rotation : rotations)
       add(Rigid3(rotation, centre - rotation * model_centre));
+    if (side != nullptr && options_.grasp_rolls > 0) {
+      for (const Rigid3& start :
+           GraspStarts(palms.back(), right_hand, side->centre(), data_centre, options_))
+        add(start);
+    }
     // A tracked pose is also placed from where it was.
     if (was_tracked) add(held);
   }

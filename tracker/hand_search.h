@@ -31,6 +31,11 @@ struct HandSearchOptions {
   /// A model point's distance to the nearest hand point counts up to this, mm (and the other
   /// way round): a hypothesis is scored by the mean of both.
   double score_cap_mm = 30.0;
+  /// Where an object is seen in the hand (GraspSide), starts that hold it in the palm as well:
+  /// the palm facing the object's middle from the hand points' side (and tilted by
+  /// grasp_tilt_deg four ways), turned about its normal in grasp_rolls steps (0: none).
+  int grasp_rolls = 12;
+  double grasp_tilt_deg = 25.0;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -76,5 +81,14 @@ HandPose CurledHand(const HandModel& model, double fraction);
 /// the palm faces where the back did and the thumb lies where the little finger did; the
 /// articulation is kept. The ambiguity a depth fit can tie on (docs/tracker.md).
 HandPose TurnedOver(const HandModel& model, const HandPose& pose);
+
+/// Rigid starts (cam_from_root) for an articulation whose palm (in its root's frame) is `palm`
+/// that hold an object in the palm: the palm's normal (toward the palm, `right_hand` the
+/// model's side) points at `object` (the held object's middle) from the side of `hand` (the hand
+/// points' centroid), and tilted by options.grasp_tilt_deg four ways, each turned about the
+/// normal in options.grasp_rolls steps; the palm's middle as far from `object` as `hand` is.
+std::vector<Rigid3> GraspStarts(const PalmAxes& palm, bool right_hand,
+                                const Eigen::Vector3d& object, const Eigen::Vector3d& hand,
+                                const HandSearchOptions& options);
 
 }  // namespace ihs::tracker

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -160,6 +161,46 @@ TEST(HandSearchTest, PlacesAHandSeenFromOneSideWhereItIs) {
     EXPECT_LT(fitted_error, error);
     EXPECT_LT(fitted_error, 5.0);
   }
+}
+
+TEST(HandSearchTest, GraspStartsHoldTheObjectInThePalm) {
+  // Every start faces the object with its palm, its palm's middle as far from the object as
+  // the hand points are, the untilted ones on the line from the object to them; for either hand.
+  const Eigen::Vector3d object(10, -20, 600), hand_points(60, 10, 560);
+  HandSearchOptions options;
+  for (bool right : {true, false}) {
+    ProceduralHandOptions side;
+    side.right_hand = right;
+    const HandModel hand = MakeProceduralHand(side);
+    HandPose pose = CurledHand(hand, 0.4);
+    const PalmAxes palm = PalmAxesOf(hand, hand.JointPositions(ForwardKinematics(hand, pose)));
+    const std::vector<Rigid3> starts = GraspStarts(palm, right, object, hand_points, options);
+    ASSERT_EQ(starts.size(), 5u * options.grasp_rolls);
+    const double distance = (hand_points - object).norm();
+    for (size_t k = 0; k < starts.size(); ++k) {
+      pose.cam_from_root = starts[k];
+      const PalmAxes placed = PalmAxesOf(hand, hand.JointPositions(ForwardKinematics(hand, pose)));
+      const Eigen::Vector3d normal = (right ? 1.0 : -1.0) * placed.Normal().normalized();
+      EXPECT_GT(normal.dot((object - placed.centre).normalized()), 1 - 1e-9) << k;
+      EXPECT_NEAR((placed.centre - object).norm(), distance, 1e-6) << k;
+      if (k < static_cast<size_t>(options.grasp_rolls)) {
+        EXPECT_GT((placed.centre - object).normalized().dot((hand_points - object).normalized()),
+                  1 - 1e-9);
+      }
+      // Turned about the normal: consecutive rolls' long axes are one step apart.
+      if (k % options.grasp_rolls > 0) {
+        pose.cam_from_root = starts[k - 1];
+        const PalmAxes previous =
+            PalmAxesOf(hand, hand.JointPositions(ForwardKinematics(hand, pose)));
+        const double step = std::acos(
+            std::clamp(placed.along.normalized().dot(previous.along.normalized()), -1.0, 1.0));
+        EXPECT_LT(step, 2 * M_PI / options.grasp_rolls + 0.05) << k;
+        EXPECT_GT(step, 0.5 * M_PI / options.grasp_rolls) << k;
+      }
+    }
+  }
+  options.grasp_rolls = -1;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
 TEST(HandSearchTest, NoPointsGiveNoHypotheses) {
