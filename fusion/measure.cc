@@ -212,33 +212,11 @@ static std::optional<Eigen::Vector3d> NormalsMeet(const std::vector<Face>& faces
 
 namespace {
 
-// Each face's unit normal and area.
-struct FacetNormals {
-  std::vector<Eigen::Vector3d> normals;
-  std::vector<double> areas;
-  double total = 0;
-};
-
-FacetNormals FaceNormals(const TriangleMesh& mesh) {
-  FacetNormals out;
-  for (const auto& face : mesh.faces) {
-    const Eigen::Vector3d a = mesh.vertices[face[0]].cast<double>();
-    const Eigen::Vector3d cross = (mesh.vertices[face[1]].cast<double>() - a)
-                                      .cross(mesh.vertices[face[2]].cast<double>() - a);
-    const double twice_area = cross.norm();
-    if (!(twice_area > 0)) continue;
-    out.normals.push_back(cross / twice_area);
-    out.areas.push_back(0.5 * twice_area);
-    out.total += 0.5 * twice_area;
-  }
-  return out;
-}
-
 // Of the faces whose normals are within the tolerance of perpendicular to `across` (all faces
 // when `across` is zero), the direction the most area faces (either way) within
 // `cos_tolerance`, refined to the area-weighted mean of those normals (in the plane across
 // `across`); zero when there is none.
-Eigen::Vector3d DominantDirection(const FacetNormals& facets, const Eigen::Vector3d& across,
+Eigen::Vector3d DominantDirection(const std::vector<Face>& faces, const Eigen::Vector3d& across,
                                   double cos_tolerance) {
   const double max_along = std::sqrt(std::max(0.0, 1.0 - cos_tolerance * cos_tolerance));
   const auto usable = [&](const Eigen::Vector3d& n) {
@@ -250,23 +228,23 @@ Eigen::Vector3d DominantDirection(const FacetNormals& facets, const Eigen::Vecto
   Eigen::Vector3d best = Eigen::Vector3d::Zero();
   double best_area = 0;
   // About 200 candidates, spread over the faces.
-  const size_t stride = std::max<size_t>(1, facets.normals.size() / 200);
-  for (size_t c = 0; c < facets.normals.size(); c += stride) {
-    if (!usable(facets.normals[c])) continue;
-    const Eigen::Vector3d candidate = flat(facets.normals[c]);
+  const size_t stride = std::max<size_t>(1, faces.size() / 200);
+  for (size_t c = 0; c < faces.size(); c += stride) {
+    if (!usable(faces[c].normal)) continue;
+    const Eigen::Vector3d candidate = flat(faces[c].normal);
     double area = 0;
-    for (size_t f = 0; f < facets.normals.size(); ++f) {
-      if (usable(facets.normals[f]) && std::abs(candidate.dot(facets.normals[f])) >= cos_tolerance)
-        area += facets.areas[f];
+    for (size_t f = 0; f < faces.size(); ++f) {
+      if (usable(faces[f].normal) && std::abs(candidate.dot(faces[f].normal)) >= cos_tolerance)
+        area += faces[f].area;
     }
     if (area > best_area) best_area = area, best = candidate;
   }
   if (best.isZero()) return best;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (size_t f = 0; f < facets.normals.size(); ++f) {
-    const double along = best.dot(facets.normals[f]);
-    if (usable(facets.normals[f]) && std::abs(along) >= cos_tolerance)
-      sum += (along < 0 ? -1.0 : 1.0) * facets.areas[f] * facets.normals[f];
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const double along = best.dot(faces[f].normal);
+    if (usable(faces[f].normal) && std::abs(along) >= cos_tolerance)
+      sum += (along < 0 ? -1.0 : 1.0) * faces[f].area * faces[f].normal;
   }
   return sum.isZero() ? best : flat(sum.normalized());
 }
@@ -275,23 +253,25 @@ Eigen::Vector3d DominantDirection(const FacetNormals& facets, const Eigen::Vecto
 
 BoxMeasures MeasureBox(const TriangleMesh& mesh, double tolerance_deg) {
   BoxMeasures box;
-  const FacetNormals facets = FaceNormals(mesh);
-  if (!(facets.total > 0)) return box;
+  const std::vector<Face> faces = Faces(mesh);
+  double total = 0;
+  for (const Face& face : faces) total += face.area;
+  if (!(total > 0)) return box;
   const double cos_tolerance = std::cos(tolerance_deg * M_PI / 180.0);
-  const Eigen::Vector3d first = DominantDirection(facets, Eigen::Vector3d::Zero(), cos_tolerance);
+  const Eigen::Vector3d first = DominantDirection(faces, Eigen::Vector3d::Zero(), cos_tolerance);
   if (first.isZero()) return box;
-  Eigen::Vector3d second = DominantDirection(facets, first, cos_tolerance);
+  Eigen::Vector3d second = DominantDirection(faces, first, cos_tolerance);
   if (second.isZero()) second = first.unitOrthogonal();
   second = (second - second.dot(first) * first).normalized();
   box.axes.col(0) = first;
   box.axes.col(1) = second;
   box.axes.col(2) = first.cross(second);
   double along = 0;
-  for (size_t f = 0; f < facets.normals.size(); ++f) {
-    const Eigen::Vector3d n = box.axes.transpose() * facets.normals[f];
-    if (n.cwiseAbs().maxCoeff() >= cos_tolerance) along += facets.areas[f];
+  for (const Face& face : faces) {
+    const Eigen::Vector3d n = box.axes.transpose() * face.normal;
+    if (n.cwiseAbs().maxCoeff() >= cos_tolerance) along += face.area;
   }
-  box.face_share = along / facets.total;
+  box.face_share = along / total;
   return box;
 }
 

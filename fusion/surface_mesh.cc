@@ -330,8 +330,7 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
       result.watertight = std::move(bound.mesh);
       result.cut_share = bound.removed_share;
       result.hull_cut_share = bound.hull_share;
-      result.hull_revolved = bound.hull_shape == HullShape::kRevolved;
-      result.hull_box = bound.hull_shape == HullShape::kBox;
+      result.hull_shape = bound.hull_shape;
       result.bound_ms = MillisecondsSince(start);
     }
     result.unseen_share = UnseenShare(result.watertight, result.smoothed);

@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "core/triangle_mesh.h"
+#include "fusion/closure_bound.h"
 #include "fusion/free_space.h"
 
 namespace ihs::fusion {
@@ -98,10 +99,9 @@ struct MeshingResult {
   /// seen surface's hull (0: nothing cut), and of it the hull's part.
   double cut_share = 0;
   double hull_cut_share = 0;
-  /// Whether the hull was the seen surface's revolution about its axis (a body of revolution).
-  bool hull_revolved = false;
-  /// Whether the hull was the box along the seen surface's faces (a box seen in part).
-  bool hull_box = false;
+  /// Of what the closure's hull was taken: the seen surface, its revolution about its axis (a
+  /// body of revolution) or the box along its faces (a box seen in part).
+  HullShape hull_shape = HullShape::kSeen;
   /// Pairs of `watertight`'s faces that cross (FindSelfIntersections): Poisson can fold its
   /// surface through itself, and such a mesh is closed and manifold but not watertight.
   std::int64_t self_intersections = 0;

@@ -118,8 +118,8 @@ nlohmann::json MeshSummary(const ihs::fusion::MeshingResult& meshes, double expo
             {"unseen_share", meshes.unseen_share},
             {"cut_share", meshes.cut_share},
             {"hull_cut_share", meshes.hull_cut_share},
-            {"hull_revolved", meshes.hull_revolved},
-            {"hull_box", meshes.hull_box},
+            {"hull_revolved", meshes.hull_shape == ihs::fusion::HullShape::kRevolved},
+            {"hull_box", meshes.hull_shape == ihs::fusion::HullShape::kBox},
             {"volume_mm3", meshes.watertight.IsWatertight() ? meshes.watertight.Volume() : 0.0}}}};
 }
 
@@ -165,9 +165,9 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
         "closure: %.1f %% of Poisson's volume cut away where the views saw empty space "
         "(%.1f %%) or beyond the seen surface's convex hull%s (%.1f %%)\n",
         100 * meshes.cut_share, 100 * (meshes.cut_share - meshes.hull_cut_share),
-        meshes.hull_revolved ? " (turned all round its axis)"
-        : meshes.hull_box    ? " (the box along its faces)"
-                             : "",
+        meshes.hull_shape == ihs::fusion::HullShape::kRevolved ? " (turned all round its axis)"
+        : meshes.hull_shape == ihs::fusion::HullShape::kBox    ? " (the box along its faces)"
+                                                               : "",
         100 * meshes.hull_cut_share);
   }
 }

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "core/check.h"
 #include "core/point_kd_tree.h"
@@ -217,21 +220,24 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
   if (has_confident_pose_) tracked.push_back(confident_pose_);
   if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad))
     tracked.push_back(pose_);
-  // The best placed hypotheses fitted briefly; the best few of those fitted on.
-  std::vector<HandFitResult> coarse;
+  // The best placed hypotheses fitted briefly (with their scores); the best few fitted on.
+  std::vector<std::pair<double, HandFitResult>> coarse;
   for (const SearchHypothesis& hypothesis :
        search_->Best(hand_points, frame, articulations, tracked, options_.search_candidates, side,
-                     right_hand_))
-    coarse.push_back(coarse_fitter_->Fit(hand_points, &frame, hypothesis.pose, segmentation));
+                     right_hand_)) {
+    HandFitResult fit = coarse_fitter_->Fit(hand_points, &frame, hypothesis.pose, segmentation);
+    coarse.emplace_back(Score(fit, side), std::move(fit));
+  }
   const size_t kept = std::min<size_t>(coarse.size(), options_.search_refined);
   std::partial_sort(coarse.begin(), coarse.begin() + kept, coarse.end(),
-                    [&](const HandFitResult& a, const HandFitResult& b) {
-                      return Score(a, side) < Score(b, side);
-                    });
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
   HandFitResult best;
+  double best_score = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < kept; ++k) {
-    HandFitResult fit = initial_fitter_->Fit(hand_points, &frame, coarse[k].pose, segmentation);
-    if (k == 0 || Score(fit, side) < Score(best, side)) best = std::move(fit);
+    HandFitResult fit =
+        initial_fitter_->Fit(hand_points, &frame, coarse[k].second.pose, segmentation);
+    const double score = Score(fit, side);
+    if (k == 0 || score < best_score) best_score = score, best = std::move(fit);
   }
   return best;
 }
@@ -280,10 +286,16 @@ TrackResult HandTracker::Track(const Frame& frame) {
     return finish();
   }
 
-  const std::optional<GraspSide> held = GraspSide::Of(result.segmentation, options_.grasp_side);
-  const GraspSide* side = held ? &*held : nullptr;
+  // The object in the hand, found only when a search or the turned-over check compares poses.
+  std::optional<GraspSide> held;
+  bool held_found = false;
+  auto side = [&]() -> const GraspSide* {
+    if (!held_found) held = GraspSide::Of(result.segmentation, options_.grasp_side);
+    held_found = true;
+    return held ? &*held : nullptr;
+  };
   if (!has_pose_) {
-    result.fit = Search(points, frame, &result.segmentation, side);
+    result.fit = Search(points, frame, &result.segmentation, side());
     result.status = TrackStatus::kInitialised;
   } else {
     HandPose predicted = pose_;
@@ -300,8 +312,8 @@ TrackResult HandTracker::Track(const Frame& frame) {
   if (result.status == TrackStatus::kTracked &&
       doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
     doubtful_in_a_row_ = 0;
-    HandFitResult found = Search(points, frame, &result.segmentation, side);
-    if (Score(found, side) < Score(result.fit, side)) {
+    HandFitResult found = Search(points, frame, &result.segmentation, side());
+    if (Score(found, side()) < Score(result.fit, side())) {
       result.fit = std::move(found);
       result.status = TrackStatus::kInitialised;
     }
@@ -312,7 +324,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
       (result.status == TrackStatus::kInitialised ||
        ++frames_since_flip_check_ >= options_.flip_check_frames)) {
     frames_since_flip_check_ = 0;
-    tie = CheckTurnedOver(points, frame, result, side);
+    tie = CheckTurnedOver(points, frame, result, side());
   }
   if (result.fit.data_coverage >= options_.search_data_coverage && !tie) {
     confident_pose_ = result.fit.pose;

@@ -147,7 +147,7 @@ TEST(SurfaceMeshTest, PoissonClosesAnOpenSurfaceNearItsPoints) {
   float top = -35;
   for (const auto& v : flat.watertight.vertices) top = std::max(top, v.z());
   EXPECT_LT(top, rim_z + 1.5f);
-  EXPECT_TRUE(flat.hull_revolved);
+  EXPECT_EQ(flat.hull_shape, HullShape::kRevolved);
   EXPECT_GT(flat.cut_share, 0.01);
   EXPECT_NEAR(flat.hull_cut_share, flat.cut_share, 0.01);
 }
