@@ -94,6 +94,14 @@ void ScanRecord::Add(const FramePacket& packet) {
     entry["contacts_rejected"] = fused.pairwise.contacts_rejected;
     entry["visual_turn_deg"] = fused.pairwise.visual_turn_deg;
     entry["visual_turn_kept"] = fused.pairwise.visual_turn_kept;
+    if (fused.hand_turn != fusion::HandTurn::kUnknown) {
+      entry["hand_turn"] = fusion::ToString(fused.hand_turn);
+      if (fused.hand_turn == fusion::HandTurn::kBack) ++hand_back_frames_;
+    }
+    if (fused.hand_carried_deg > 0) {
+      entry["hand_carried_deg"] = fused.hand_carried_deg;
+      ++hand_carried_frames_;
+    }
     if (fused.pairwise.ok) {
       // The correspondences' motion before ICP: tx ty tz qx qy qz qw (mm), for diagnosis.
       const Eigen::Quaterniond q = fused.pairwise.current_from_previous.quaternion();
@@ -147,6 +155,8 @@ nlohmann::json ScanRecord::Summary() const {
                             {"hand_turned_over_frames", turned_over_frames_},
                             {"held_grasp_frames", held_grasp_frames_},
                             {"icp_slid_frames", icp_slid_frames_},
+                            {"hand_carried_frames", hand_carried_frames_},
+                            {"hand_back_frames", hand_back_frames_},
                             {"fusion_status_counts", fusion_counts_},
                             {"skip_reasons", skip_reasons_},
                             {"coverage", coverage_},

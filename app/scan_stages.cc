@@ -133,7 +133,20 @@ ObjectStage::ObjectStage(const ScannerOptions& options, const CameraIntrinsics& 
 
 ObjectStage::~ObjectStage() = default;
 
+std::optional<Rigid3> ObjectStage::HandMotion(const FramePacket& packet) {
+  std::optional<Rigid3> motion;
+  const bool has_pose = packet.frame_error.empty() && packet.track.HasPose();
+  // A pose fitted anew (a search won) is not the previous one moved.
+  if (has_pose && previous_root_ && packet.track.status == tracker::TrackStatus::kTracked) {
+    motion = packet.track.pose.cam_from_root * previous_root_->Inverse();
+  }
+  previous_root_.reset();
+  if (has_pose) previous_root_ = packet.track.pose.cam_from_root;
+  return motion;
+}
+
 void ObjectStage::Process(FramePacket& packet) {
+  std::optional<Rigid3> hand_motion = HandMotion(packet);
   if (!packet.frame_error.empty()) {
     packet.fusion = fusion_.Skip("malformed frame: " + packet.frame_error);
     return;
@@ -163,6 +176,7 @@ void ObjectStage::Process(FramePacket& packet) {
     input.hand = packet.hand_mesh.get();
     input.fingertips = packet.fingertips.get();
   }
+  input.hand_motion = hand_motion;
   packet.fusion = fusion_.Fuse(input);
 }
 

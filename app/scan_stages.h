@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -128,9 +129,14 @@ class ObjectStage {
   const fusion::TsdfVolume& volume() const { return fusion_.volume(); }
 
  private:
+  // The hand's motion since the previous frame, where the tracker followed it from there.
+  std::optional<Rigid3> HandMotion(const FramePacket& packet);
+
   const ScanOptions options_;
   std::vector<std::unique_ptr<fusion::CorrespondenceSource>> sources_;
   fusion::ObjectFusion fusion_;
+  // The hand's root pose in the previous frame, where it had one.
+  std::optional<Rigid3> previous_root_;
 };
 
 }  // namespace ihs::app

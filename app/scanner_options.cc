@@ -292,6 +292,19 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "share of a fingertip's vertices on the surface that makes it a contact");
   r.Add("fusion.model_contacts.min_fingertips", &u.model_contacts.min_fingertips,
         "fingertips on the surface needed for any to count");
+  r.Add("fusion.turn_carry.enabled", &u.turn_carry.enabled,
+        "once the hand is seen turning the object one way, it carries the turn the surface "
+        "leaves free (a ball's, a bottle's about its axis) and turning back leaves it");
+  r.Add("fusion.turn_carry.window_frames", &u.turn_carry.window_frames,
+        "frames with contacts over which the one-way turn is recognised");
+  r.Add("fusion.turn_carry.recognise_deg", &u.turn_carry.recognise_deg,
+        "the hand's net turn over those frames that recognises it, degrees");
+  r.Add("fusion.turn_carry.min_consistency", &u.turn_carry.min_consistency,
+        "the net turn's least share of all the turning in those frames");
+  r.Add("fusion.turn_carry.smoothing_frames", &u.turn_carry.smoothing_frames,
+        "frames the hand's turn is averaged over to tell turning on from back");
+  r.Add("fusion.turn_carry.max_frame_turn_deg", &u.turn_carry.max_frame_turn_deg,
+        "a hand turning farther than this in one frame was refitted, not followed, degrees");
   r.Add("fusion.coverage.max_incidence_deg", &u.coverage.max_incidence_deg,
         "a surface counts as seen from a camera within this angle of its normal, degrees "
         "(coverage)");

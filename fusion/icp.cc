@@ -93,6 +93,7 @@ class Aligner {
   double rms() const { return rms_; }
   int iterations() const { return iterations_; }
   int free_directions() const { return free_directions_; }
+  const Eigen::Vector3d& pivot() const { return pivot_; }
 
  private:
   // One iteration; returns whether another may follow.
@@ -400,6 +401,7 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   result.slid = aligner.slid();
   result.rms_mm = aligner.rms();
   result.free_directions = aligner.free_directions();
+  result.pivot = aligner.pivot();
   // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.
   result.cam_from_volume = aligner.correction().Inverse() * predicted;
   CheckEnoughPairs(needed, points.size(), &result);

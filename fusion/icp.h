@@ -82,6 +82,10 @@ struct IcpResult {
   /// (IcpOptions::min_constraint_over_noise) in the last iteration: a ball's 3, a bottle's 1;
   /// -1 where that was not judged (anchors joined every direction, or the rule is off).
   int free_directions = -1;
+  /// Where the turns were taken about (camera frame, mm): where the model's normal lines meet
+  /// (a ball's centre, a point on a bottle's axis) where the free directions were judged, else
+  /// the points' centroid.
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
 };
 
 /// A point of the current frame (camera frame, mm) that must land at `target`, where the

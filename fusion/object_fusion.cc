@@ -29,6 +29,7 @@ void FusionOptions::Check() const {
   icp.Check();
   model_contacts.Check();
   coverage.Check();
+  turn_carry.Check();
   free_space.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
@@ -49,7 +50,8 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       volume_(options_.tsdf),
       coverage_(options_.coverage),
       free_space_(intrinsics, options_.free_space),
-      contact_noise_mm_(options_.contact_noise_reference_mm) {}
+      contact_noise_mm_(options_.contact_noise_reference_mm),
+      turn_carry_(options_.turn_carry) {}
 
 FusionResult ObjectFusion::Skip(std::string reason) const {
   FusionResult result;
@@ -142,9 +144,14 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     return finish(FusionStatus::kStarted);
   }
 
-  // The correspondences' motion, then ICP from there.
+  // The correspondences' motion (or the hand's turn), then ICP from there.
+  result.hand_turn = JudgeHandTurn(input);
   std::vector<PointMatch> contacts;
-  Rigid3 pose = Register(input, &contacts, &result);
+  Rigid3 pose = Register(input, result.hand_turn != HandTurn::kBack, &contacts, &result);
+  if (result.hand_turn == HandTurn::kOn && !result.pairwise.ok) {
+    pose = turn_carry_.Carry(cam_from_object_, cam_from_object_ * pivot_in_object_);
+    result.hand_carried_deg = turn_carry_.carried_rad() * 180.0 / M_PI;
+  }
   if (options_.use_icp) {
     if (!Refine(object, contacts, &pose, &result)) {
       return finish(FusionStatus::kSkipped,
@@ -161,7 +168,15 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   UpdateContactNoise(contacts, step, &result);
   Integrate(input, object, pose, &result);
   UpdateAnchors(contacts, pose);
+  turn_carry_.Learn(result.ContactsUsed());
   return finish(FusionStatus::kFused);
+}
+
+HandTurn ObjectFusion::JudgeHandTurn(const FusionInput& input) {
+  const HandTurn turn = turn_carry_.Judge(input.hand_motion, cam_from_object_);
+  // Where the surface fixes every direction (a box), ICP follows the object by itself.
+  if (!options_.turn_carry.enabled || free_directions_seen_ <= 0) return HandTurn::kUnknown;
+  return turn;
 }
 
 FusionResult ObjectFusion::Finish(const FusionInput& input, SteadyClock::time_point started_at,
@@ -223,20 +238,22 @@ void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& objec
   free_space_.Observe(object.frame, object.box, pose, input.hand);
 }
 
-Rigid3 ObjectFusion::Register(const FusionInput& input, std::vector<PointMatch>* contacts,
-                              FusionResult* result) const {
+Rigid3 ObjectFusion::Register(const FusionInput& input, bool with_contacts,
+                              std::vector<PointMatch>* contacts, FusionResult* result) const {
   Rigid3 pose = cam_from_object_;
   const auto pairwise_start = SteadyClock::now();
   // The contact sets as one, with the model's contacts and the anchors.
   PairwiseInput correspondences;
   for (const MatchSet& set : input.correspondences.sets) {
     if (set.kind == MatchKind::kVisual) correspondences.sets.push_back(set);
-    if (set.kind == MatchKind::kContact) {
+    if (set.kind == MatchKind::kContact && with_contacts) {
       contacts->insert(contacts->end(), set.pairs.begin(), set.pairs.end());
     }
   }
-  result->model_contacts = AddModelContacts(input, contacts);
-  result->anchored_contacts = ApplyAnchors(contacts);
+  if (with_contacts) {
+    result->model_contacts = AddModelContacts(input, contacts);
+    result->anchored_contacts = ApplyAnchors(contacts);
+  }
   correspondences.sets.push_back({"contacts", MatchKind::kContact, *contacts});
   result->pairwise = RegisterPair(correspondences, options_.pairwise);
   result->pairwise_ms = MillisecondsSince(pairwise_start);
@@ -269,7 +286,9 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   }
   if (result->icp.ok) {
     surface_left_free_ = result->icp.free_directions != 0;
+    if (result->icp.free_directions >= 0) free_directions_seen_ = result->icp.free_directions;
     *pose = result->icp.cam_from_volume;
+    pivot_in_object_ = pose->Inverse() * result->icp.pivot;
     return true;
   }
   return result->pairwise.ok;

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "fusion/model_contacts.h"
 #include "fusion/pairwise_registration.h"
 #include "fusion/tsdf_volume.h"
+#include "fusion/turn_carry.h"
 #include "fusion/view_coverage.h"
 
 namespace ihs::fusion {
@@ -37,6 +39,9 @@ struct FusionOptions {
   ViewCoverageOptions coverage;
   /// Which registered frames' depth is kept to bound the closure by the space seen empty.
   FreeSpaceOptions free_space;
+  /// The turn the hand carries where the surface leaves it free (turn_carry.h); it needs
+  /// FusionInput::hand_motion.
+  TurnCarryOptions turn_carry;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -100,6 +105,9 @@ struct FusionInput {
   /// hand's volume is space the object is not in (free_space.h).
   const TriangleMesh* hand = nullptr;
   const std::vector<std::vector<int>>* fingertips = nullptr;
+  /// The hand's motion since the previous frame (camera frame: current_from_previous of its
+  /// root), where the tracker followed it from there; none otherwise (turn_carry.h).
+  std::optional<Rigid3> hand_motion = std::nullopt;
 };
 
 /// What happened to a frame.
@@ -132,6 +140,11 @@ struct FusionResult {
   int model_contacts = 0;
   /// Contacts that held ICP as anchors (FusionOptions::icp_contacts_need_spread).
   int icp_anchors = 0;
+  /// How the hand turned against the recognised one-way turn (turn_carry.h; kUnknown where
+  /// that does not apply), and how far it carried the object where nothing else registered
+  /// the frame, degrees. Where it turned back, the contacts were not used.
+  HandTurn hand_turn = HandTurn::kUnknown;
+  double hand_carried_deg = 0;
   /// Whether the contacts took part: in the registration or as ICP's anchors.
   bool ContactsUsed() const { return pairwise.contacts > 0 || icp_anchors > 0; }
   /// The contacts' disagreement with the final pose in this frame (median distance, mm; 0
@@ -206,9 +219,12 @@ class ObjectFusion {
   void Integrate(const FusionInput& input, const ObjectPixels& object, const Rigid3& pose,
                  FusionResult* result);
   // The correspondences' motion applied to the previous pose (that pose where the registration
-  // fails); `contacts` gets the contact pairs used (the model's included, anchors applied).
-  Rigid3 Register(const FusionInput& input, std::vector<PointMatch>* contacts,
+  // fails); `contacts` gets the contact pairs used (the model's included, anchors applied),
+  // none without `with_contacts`.
+  Rigid3 Register(const FusionInput& input, bool with_contacts, std::vector<PointMatch>* contacts,
                   FusionResult* result) const;
+  // How the hand turns in this frame, where the object's surface leaves a turn free.
+  HandTurn JudgeHandTurn(const FusionInput& input);
   // ICP from the registered `pose` (and from the previous one where that pairs too few), which
   // it replaces when ICP succeeds; false when neither the registration nor ICP found a pose.
   bool Refine(const ObjectPixels& object, const std::vector<PointMatch>& contacts, Rigid3* pose,
@@ -256,12 +272,17 @@ class ObjectFusion {
   Rigid3 last_step_;
   // Whether the last frame's ICP left a direction free (FusionOptions::predict_moving).
   bool surface_left_free_ = true;
+  // How many directions the surface left free the last time ICP judged it (-1: never).
+  int free_directions_seen_ = -1;
+  // Where the last ICP took its turns about, in the object frame.
+  Eigen::Vector3d pivot_in_object_ = Eigen::Vector3d::Zero();
   // The running estimate of the contacts' disagreement with the registered motion, mm (starts
   // at the reference: the configured share until contacts have been seen).
   double contact_noise_mm_ = 0;
   std::unordered_map<int, Anchor> anchors_;
   // The hand's vertices in the previous frame, when it was registered (else empty).
   std::vector<Eigen::Vector3f> previous_hand_;
+  TurnCarry turn_carry_;
 };
 
 }  // namespace ihs::fusion

@@ -140,6 +140,14 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
   if (const int slid = count(summary, "icp_slid_frames"); slid > 0)
     std::printf("  ICP slid off what it started on in %d frames: its best-paired iterate kept\n",
                 slid);
+  if (const int carried = count(summary, "hand_carried_frames"),
+      back = count(summary, "hand_back_frames");
+      carried + back > 0) {
+    std::printf(
+        "  the object turned one way: the hand carried its free turn in %d frames, turned back "
+        "without it in %d\n",
+        carried, back);
+  }
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
   std::printf(

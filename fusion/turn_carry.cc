@@ -1,0 +1,92 @@
+#include "fusion/turn_carry.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numeric>
+
+#include "core/check.h"
+
+namespace ihs::fusion {
+
+void TurnCarryOptions::Check() const {
+  IHS_CHECK_ARG(window_frames >= 2 && window_frames <= 1000,
+                "fusion.turn_carry.window_frames must be in [2, 1000]");
+  IHS_CHECK_ARG(recognise_deg > 0 && recognise_deg <= 360,
+                "fusion.turn_carry.recognise_deg must be in (0, 360]");
+  IHS_CHECK_ARG(min_consistency > 0 && min_consistency <= 1,
+                "fusion.turn_carry.min_consistency must be in (0, 1]");
+  IHS_CHECK_ARG(smoothing_frames >= 1 && smoothing_frames <= 100,
+                "fusion.turn_carry.smoothing_frames must be in [1, 100]");
+  IHS_CHECK_ARG(max_frame_turn_deg > 0 && max_frame_turn_deg <= 180,
+                "fusion.turn_carry.max_frame_turn_deg must be in (0, 180]");
+}
+
+const char* ToString(HandTurn turn) {
+  switch (turn) {
+    case HandTurn::kUnknown:
+      return "unknown";
+    case HandTurn::kOn:
+      return "on";
+    case HandTurn::kBack:
+      return "back";
+  }
+  return "unknown";
+}
+
+TurnCarry::TurnCarry(TurnCarryOptions options) : options_((options.Check(), options)) {}
+
+HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3& cam_from_object) {
+  turn_.reset();
+  carried_rad_ = 0;
+  const Eigen::AngleAxisd step(hand_motion ? hand_motion->rotation() : Eigen::Matrix3d::Identity());
+  if (!hand_motion || step.angle() > options_.max_frame_turn_deg * M_PI / 180.0) {
+    along_axis_.clear();
+    return HandTurn::kUnknown;
+  }
+  // The hand's turn in the object frame, where a turn about the object's own axis stays put.
+  turn_ = cam_from_object.rotation().transpose() * (step.axis() * step.angle());
+  if (!recognised_) return HandTurn::kUnknown;
+  const double along = turn_->dot(axis_);
+  along_axis_.push_back(along);
+  while (static_cast<int>(along_axis_.size()) > options_.smoothing_frames) along_axis_.pop_front();
+  const double mean =
+      std::accumulate(along_axis_.begin(), along_axis_.end(), 0.0) / along_axis_.size();
+  if (along > 0 && mean > 0) {
+    carried_rad_ = along;
+    return HandTurn::kOn;
+  }
+  return HandTurn::kBack;
+}
+
+void TurnCarry::Learn(bool contacts_used) {
+  if (recognised_ || !contacts_used || !turn_) return;
+  contact_turns_.push_back(*turn_);
+  while (static_cast<int>(contact_turns_.size()) > options_.window_frames) {
+    contact_turns_.pop_front();
+  }
+  Recognise();
+}
+
+void TurnCarry::Recognise() {
+  Eigen::Vector3d net = Eigen::Vector3d::Zero();
+  double travelled = 0;
+  for (const Eigen::Vector3d& turn : contact_turns_) {
+    net += turn;
+    travelled += turn.norm();
+  }
+  const double net_deg = net.norm() * 180.0 / M_PI;
+  if (net_deg >= options_.recognise_deg && net.norm() >= options_.min_consistency * travelled) {
+    recognised_ = true;
+    axis_ = net.normalized();
+    contact_turns_.clear();
+  }
+}
+
+Rigid3 TurnCarry::Carry(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot) const {
+  const Eigen::Vector3d axis = cam_from_object.rotation() * axis_;
+  const Rigid3 turn = Rigid3::Translation(pivot) * Rigid3::FromAxisAngle(axis, carried_rad_) *
+                      Rigid3::Translation(-pivot);
+  return turn * cam_from_object;
+}
+
+}  // namespace ihs::fusion

@@ -1,0 +1,98 @@
+#pragma once
+// The turn the hand carries (ours, beyond the paper). A ball, or a bottle about its axis, shows
+// ICP nothing of how it turns, and the fingertip contacts that would are found in some held
+// frames only: on the scripted full turns the object lost all the turn of the held frames
+// without contacts (60-190° of 360°), and the contacts the tracker found while the hand swung
+// back to re-grasp — fingers lifted 8-11 mm off, within the detector's grown threshold — turned
+// it back by 100-230° (docs/fusion.md, "Where the lathe turns are lost"). Neither the fitted
+// fingertips nor the depth around them tells a held object from a released one.
+//
+// What does: an object turned all the way round is turned one way, and the hand swings back
+// without it. Once the hand has been seen to turn the object consistently one way (its turn
+// over the recent frames whose contacts moved the object), that way is the object's: in a frame
+// where the hand turns on that way, the object turns with it in the directions its surface
+// leaves free (where nothing else registers the frame); where the hand turns back, it does not,
+// whatever contacts were found. Motions that go back and forth (the paper's recorded sessions)
+// never show a consistent one-way turn, and then nothing changes.
+
+#include <Eigen/Core>
+#include <deque>
+#include <optional>
+
+#include "core/rigid3.h"
+
+namespace ihs::fusion {
+
+/// Options of the hand-carried turn (ObjectFusion, FusionInput::hand_motion).
+struct TurnCarryOptions {
+  /// Carry the object's free turn with the hand once a one-way turn is recognised.
+  bool enabled = true;
+  /// A one-way turn is recognised when, over the last `window_frames` frames whose contacts
+  /// moved the object, the hand turned by at least `recognise_deg` about one axis, and that is
+  /// at least `min_consistency` of all the turning it did in those frames (back and forth
+  /// cancels; so does the fit's wobble of 1-2° a frame about other axes). The scripted full
+  /// turns turn 2-4° a frame while held: 40° is half a stroke of their grasps. With 15 frames,
+  /// 30° and 0.8, a release whose lifted fingers were still taken for contacts was recognised
+  /// as the turn in one of twenty generated turns (docs/fusion.md).
+  int window_frames = 20;
+  double recognise_deg = 40.0;
+  double min_consistency = 0.7;
+  /// The hand turns on in a frame where its turn about the recognised axis is forward in that
+  /// frame and on average over the last this many frames (one frame's fitting noise is not a
+  /// stroke).
+  int smoothing_frames = 3;
+  /// A hand that turns farther than this in one frame was refitted rather than followed (a
+  /// fit that flipped, a search): its motion says nothing of the object's, degrees.
+  double max_frame_turn_deg = 15.0;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// How the hand turns in a frame, relative to the recognised one-way turn.
+enum class HandTurn {
+  kUnknown,  ///< No one-way turn recognised yet, or no hand motion in this frame.
+  kOn,       ///< The hand turns on the recognised way: it carries the object.
+  kBack,     ///< It turns back (or stands): the object stays.
+};
+
+/// A short name for stats ("unknown", "on", "back").
+const char* ToString(HandTurn turn);
+
+/// Recognises the one-way turn and judges each frame's hand motion against it. Not
+/// thread-safe; ObjectFusion owns one.
+class TurnCarry {
+ public:
+  explicit TurnCarry(TurnCarryOptions options = {});
+
+  /// This frame's hand motion (camera frame; none when the tracker did not follow the hand
+  /// from the previous frame) with the object's previous pose: how the hand turns.
+  HandTurn Judge(const std::optional<Rigid3>& hand_motion, const Rigid3& cam_from_object);
+  /// After the frame: whether its contacts moved the object (the frames the one-way turn is
+  /// recognised from).
+  void Learn(bool contacts_used);
+  /// The object's previous pose carried by this frame's turn (after Judge returned kOn) about
+  /// `pivot` (camera frame), and the angle, radians.
+  Rigid3 Carry(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot) const;
+  double carried_rad() const { return carried_rad_; }
+
+  bool recognised() const { return recognised_; }
+  /// The recognised turn's axis in the object frame (unit; zero until recognised).
+  const Eigen::Vector3d& axis() const { return axis_; }
+
+ private:
+  void Recognise();
+
+  TurnCarryOptions options_;
+  bool recognised_ = false;
+  Eigen::Vector3d axis_ = Eigen::Vector3d::Zero();
+  // This frame's hand turn in the object frame (rotation vector, radians), when there is one.
+  std::optional<Eigen::Vector3d> turn_;
+  // The hand's turns of the last frames whose contacts moved the object (object frame).
+  std::deque<Eigen::Vector3d> contact_turns_;
+  // The hand's turn about the axis in the last frames (radians; cleared where it is unknown).
+  std::deque<double> along_axis_;
+  double carried_rad_ = 0;
+};
+
+}  // namespace ihs::fusion

@@ -1,0 +1,185 @@
+// The turn the hand carries: a one-way turn recognised from the frames whose contacts moved
+// the object (and not from back-and-forth), each frame's hand motion judged against it, and a
+// rendered ball turned all the way round in strokes — held and turned, then let go while the
+// hand swings back with contacts that are not there — followed only with it.
+
+#include "fusion/turn_carry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "fusion/object_fusion.h"
+#include "tests/frame_fixtures.h"
+#include "tests/test_util.h"
+
+namespace ihs::fusion {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A hand turned by `degrees` about `axis` (camera frame) through `pivot`.
+Rigid3 HandTurnBy(double degrees, const Eigen::Vector3d& axis,
+                  const Eigen::Vector3d& pivot = Eigen::Vector3d(0, 0, 500)) {
+  return Rigid3::Translation(pivot) * Rigid3::FromAxisAngle(axis.normalized(), degrees * kDeg) *
+         Rigid3::Translation(-pivot);
+}
+
+TEST(TurnCarryTest, AOneWayTurnIsRecognisedFromTheFramesWithContacts) {
+  // The object is tilted: the axis is learnt in its frame.
+  const Rigid3 cam_from_object = Rigid3::FromAxisAngle({1, 0, 0}, 0.5);
+  const Eigen::Vector3d axis(0.2, 1, 0.1);
+  TurnCarry carry;
+  std::mt19937 rng = test::Rng();
+  std::normal_distribution<double> noise(0, 0.3);
+  int frames = 0;
+  while (!carry.recognised() && frames < 100) {
+    // 2.5° a frame, each frame's fit off by 0.3° about every axis.
+    const Rigid3 motion =
+        HandTurnBy(2.5, axis) *
+        Rigid3::FromRotationVector(kDeg * Eigen::Vector3d(noise(rng), noise(rng), noise(rng)),
+                                   Eigen::Vector3d::Zero());
+    EXPECT_EQ(carry.Judge(motion, cam_from_object), HandTurn::kUnknown);
+    carry.Learn(true);
+    ++frames;
+  }
+  // 40° at 2.5° a frame: sixteen frames.
+  EXPECT_GE(frames, 15);
+  EXPECT_LE(frames, 17);
+  const Eigen::Vector3d expected = cam_from_object.rotation().transpose() * axis.normalized();
+  EXPECT_GT(carry.axis().dot(expected), 0.99);
+
+  // On: the hand's turn about the axis is carried; back: nothing (after the smoothing's frames).
+  EXPECT_EQ(carry.Judge(HandTurnBy(3, axis), cam_from_object), HandTurn::kOn);
+  EXPECT_NEAR(carry.carried_rad(), 3 * kDeg, 0.05 * kDeg);
+  const Eigen::Vector3d pivot(0, 0, 500);
+  const Rigid3 carried = carry.Carry(cam_from_object, pivot);
+  EXPECT_LT((carried * cam_from_object.Inverse() * pivot - pivot).norm(), 1e-9)
+      << "turned about the pivot";
+  EXPECT_NEAR(
+      Eigen::AngleAxisd(carried.rotation() * cam_from_object.rotation().transpose()).angle(),
+      3 * kDeg, 0.05 * kDeg);
+  EXPECT_EQ(carry.Judge(HandTurnBy(-4, axis), cam_from_object), HandTurn::kBack);
+  EXPECT_EQ(carry.carried_rad(), 0);
+  // A frame that turns on again while the last frames turned back on average is not yet on.
+  EXPECT_EQ(carry.Judge(HandTurnBy(0.5, axis), cam_from_object), HandTurn::kBack);
+  EXPECT_EQ(carry.Judge(std::nullopt, cam_from_object), HandTurn::kUnknown);
+  EXPECT_EQ(carry.Judge(HandTurnBy(20, axis), cam_from_object), HandTurn::kUnknown)
+      << "a hand that turned 20° in a frame was refitted";
+  EXPECT_EQ(carry.Judge(HandTurnBy(0.5, axis), cam_from_object), HandTurn::kOn)
+      << "a gap in the hand's motion starts the smoothing anew";
+}
+
+TEST(TurnCarryTest, BackAndForthOrTurnsWithoutContactsAreNeverRecognised) {
+  const Eigen::Vector3d axis(0, 1, 0);
+  TurnCarry wiggled;
+  TurnCarry without_contacts;
+  for (int i = 0; i < 600; ++i) {
+    // Strokes of eight frames, 3° a frame, one way then the other (the recorded sessions
+    // turn back and forth like this while held).
+    const double degrees = (i / 8) % 2 == 0 ? 3.0 : -3.0;
+    wiggled.Judge(HandTurnBy(degrees, axis), Rigid3());
+    wiggled.Learn(true);
+    without_contacts.Judge(HandTurnBy(3.0, axis), Rigid3());
+    without_contacts.Learn(false);
+  }
+  EXPECT_FALSE(wiggled.recognised());
+  EXPECT_FALSE(without_contacts.recognised());
+  EXPECT_EQ(wiggled.Judge(HandTurnBy(3, axis), Rigid3()), HandTurn::kUnknown);
+}
+
+TEST(TurnCarryTest, BadOptionsAreRefused) {
+  TurnCarryOptions options;
+  options.min_consistency = 0;
+  EXPECT_THROW(TurnCarry{options}, std::invalid_argument);
+  options = {};
+  options.window_frames = 1;
+  EXPECT_THROW(TurnCarry{options}, std::invalid_argument);
+}
+
+// A ball turned all the way round by a hand, in four strokes: held and turned 90° in 30
+// frames (3° a frame) — with contacts on it in two of three frames of the first stroke only, as
+// when the tracker finds the grasp at the start and then loses the fingertips behind the ball —
+// then let go while the
+// hand swings back 90° in 15 frames with contacts that move with it (fingers lifted off, within
+// the detector's threshold). Returns the largest rotation error at the end of a held stroke,
+// degrees (after a whole turn the end alone says little: a scan that follows none of it ends
+// where it started).
+double BallTurnedInStrokes(const FusionOptions& options, int* carried_frames) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  const Eigen::Vector3d centre(10, -5, 550);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.2, 1, 0.3).normalized();
+  const double radius = 35;
+  // Points of the ball the fingers touch (object frame).
+  const std::vector<Eigen::Vector3d> touched = {
+      {radius, 0, 0}, {0, 0, -radius}, {-radius * 0.7, 0, -radius * 0.7}};
+  ObjectFusion fusion(intrinsics, options);
+  double object_deg = 0, hand_deg = 0, worst = 0;
+  Rigid3 first;
+  *carried_frames = 0;
+  auto truth = [&](double degrees) {
+    return Rigid3::Translation(centre) * Rigid3::FromAxisAngle(axis, degrees * kDeg);
+  };
+  for (int stroke = 0; stroke < 4; ++stroke) {
+    for (int i = 0; i < 45; ++i) {
+      const bool held = i < 30;
+      const double step = held ? 3.0 : -6.0;
+      const double before_object = object_deg, before_hand = hand_deg;
+      hand_deg += step;
+      if (held) object_deg += step;
+      const Frame frame =
+          test::RenderEllipsoid(intrinsics, truth(object_deg), Eigen::Vector3d::Constant(radius));
+      std::vector<std::uint8_t> mask(frame.depth_mm.size());
+      for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+      FusionInput input{&frame, &mask, {}};
+      input.hand_motion = HandTurnBy(step, axis, centre);
+      if ((held && stroke == 0 && i % 3 != 0) || !held) {
+        // Contacts: where the ball was touched (held), or the lifted fingers moving with the
+        // hand (let go).
+        for (const Eigen::Vector3d& q : touched) {
+          input.correspondences.Pairs("contacts", MatchKind::kContact)
+              .push_back({truth(held ? before_object : before_hand) * q,
+                          truth(held ? object_deg : hand_deg) * q});
+        }
+      }
+      const FusionResult result = fusion.Fuse(input);
+      if (stroke == 0 && i == 0) first = result.cam_from_object;
+      if (result.hand_carried_deg > 0) ++*carried_frames;
+      if (i == 29) {
+        // The object's turn since the first frame, scanned against the truth's.
+        const Rigid3 scanned = result.cam_from_object * first.Inverse();
+        const Rigid3 expected = truth(object_deg) * truth(3.0).Inverse();
+        worst = std::max(
+            worst,
+            Eigen::AngleAxisd(scanned.rotation() * expected.rotation().transpose()).angle() / kDeg);
+      }
+    }
+  }
+  return worst;
+}
+
+TEST(TurnCarryTest, ABallTurnedAllTheWayRoundInStrokesIsFollowedByTheHand) {
+  FusionOptions off;
+  off.turn_carry.enabled = false;
+  int carried_on = 0, carried_off = 0;
+  const double with_carry = BallTurnedInStrokes({}, &carried_on);
+  const double without = BallTurnedInStrokes(off, &carried_off);
+  std::printf(
+      "ball, 360° in four strokes: worst rotation error at a stroke's end %.1f° with the hand's "
+      "turn (carried in %d frames), %.1f° without\n",
+      with_carry, carried_on, without);
+  EXPECT_EQ(carried_off, 0);
+  // The held frames without contacts after the turn was recognised (40° into the first stroke)
+  // are carried, but for one or two after each swing back (the smoothing). What is lost: the
+  // frames without contacts before it was recognised and those, 3° each.
+  // Measured: 89 frames carried, 31.3° against 152.9°.
+  EXPECT_GE(carried_on, 80);
+  EXPECT_LT(with_carry, 35.0);
+  // Without it the swings back undo each stroke and the strokes without contacts are lost.
+  EXPECT_GT(without, 100.0);
+}
+
+}  // namespace
+}  // namespace ihs::fusion
