@@ -116,6 +116,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["icp_first_inliers"] = fused.icp.first_inliers;
       entry["icp_points"] = fused.icp.points;
       if (fused.icp.slid) entry["icp_slid"] = true, ++icp_slid_frames_;
+      if (fused.icp.free_directions >= 0) entry["icp_free_directions"] = fused.icp.free_directions;
       entry["icp_rms_mm"] = fused.icp.rms_mm;
     }
   }

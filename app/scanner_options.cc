@@ -303,8 +303,14 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "the net turn's least share of all the turning in those frames");
   r.Add("fusion.turn_carry.smoothing_frames", &u.turn_carry.smoothing_frames,
         "frames the hand's turn is averaged over to tell turning on from back");
+  r.Add("fusion.turn_carry.recognise_max_frame_deg", &u.turn_carry.recognise_max_frame_deg,
+        "a frame's turn counts at most this much towards recognising it, degrees");
   r.Add("fusion.turn_carry.max_frame_turn_deg", &u.turn_carry.max_frame_turn_deg,
         "a hand turning farther than this in one frame was refitted, not followed, degrees");
+  r.Add("fusion.turn_carry.surface_frames", &u.turn_carry.surface_frames,
+        "frames over which ICP's free directions are counted");
+  r.Add("fusion.turn_carry.min_free_share", &u.turn_carry.min_free_share,
+        "least share of those frames with a free direction for the hand to carry the turn");
   r.Add("fusion.coverage.max_incidence_deg", &u.coverage.max_incidence_deg,
         "a surface counts as seen from a camera within this angle of its normal, degrees "
         "(coverage)");

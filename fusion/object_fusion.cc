@@ -175,7 +175,9 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
 HandTurn ObjectFusion::JudgeHandTurn(const FusionInput& input) {
   const HandTurn turn = turn_carry_.Judge(input.hand_motion, cam_from_object_);
   // Where the surface fixes every direction (a box), ICP follows the object by itself.
-  if (!options_.turn_carry.enabled || free_directions_seen_ <= 0) return HandTurn::kUnknown;
+  if (!options_.turn_carry.enabled || !turn_carry_.SurfaceLeavesTurnFree()) {
+    return HandTurn::kUnknown;
+  }
   return turn;
 }
 
@@ -286,7 +288,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   }
   if (result->icp.ok) {
     surface_left_free_ = result->icp.free_directions != 0;
-    if (result->icp.free_directions >= 0) free_directions_seen_ = result->icp.free_directions;
+    turn_carry_.ObserveSurface(result->icp.free_directions);
     *pose = result->icp.cam_from_volume;
     pivot_in_object_ = pose->Inverse() * result->icp.pivot;
     return true;

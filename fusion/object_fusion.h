@@ -272,8 +272,6 @@ class ObjectFusion {
   Rigid3 last_step_;
   // Whether the last frame's ICP left a direction free (FusionOptions::predict_moving).
   bool surface_left_free_ = true;
-  // How many directions the surface left free the last time ICP judged it (-1: never).
-  int free_directions_seen_ = -1;
   // Where the last ICP took its turns about, in the object frame.
   Eigen::Vector3d pivot_in_object_ = Eigen::Vector3d::Zero();
   // The running estimate of the contacts' disagreement with the registered motion, mm (starts

@@ -1,6 +1,7 @@
 #include "fusion/turn_carry.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -17,8 +18,14 @@ void TurnCarryOptions::Check() const {
                 "fusion.turn_carry.min_consistency must be in (0, 1]");
   IHS_CHECK_ARG(smoothing_frames >= 1 && smoothing_frames <= 100,
                 "fusion.turn_carry.smoothing_frames must be in [1, 100]");
+  IHS_CHECK_ARG(recognise_max_frame_deg > 0,
+                "fusion.turn_carry.recognise_max_frame_deg must be > 0");
   IHS_CHECK_ARG(max_frame_turn_deg > 0 && max_frame_turn_deg <= 180,
                 "fusion.turn_carry.max_frame_turn_deg must be in (0, 180]");
+  IHS_CHECK_ARG(surface_frames >= 1 && surface_frames <= 1000,
+                "fusion.turn_carry.surface_frames must be in [1, 1000]");
+  IHS_CHECK_ARG(min_free_share >= 0 && min_free_share <= 1,
+                "fusion.turn_carry.min_free_share must be in [0, 1]");
 }
 
 const char* ToString(HandTurn turn) {
@@ -60,7 +67,9 @@ HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3
 
 void TurnCarry::Learn(bool contacts_used) {
   if (recognised_ || !contacts_used || !turn_) return;
-  contact_turns_.push_back(*turn_);
+  const double most = options_.recognise_max_frame_deg * M_PI / 180.0;
+  contact_turns_.push_back(turn_->norm() > most ? Eigen::Vector3d(turn_->normalized() * most)
+                                                : *turn_);
   while (static_cast<int>(contact_turns_.size()) > options_.window_frames) {
     contact_turns_.pop_front();
   }
@@ -80,6 +89,20 @@ void TurnCarry::Recognise() {
     axis_ = net.normalized();
     contact_turns_.clear();
   }
+}
+
+void TurnCarry::ObserveSurface(int free_directions) {
+  if (free_directions < 0) return;
+  surface_free_.push_back(free_directions > 0);
+  while (static_cast<int>(surface_free_.size()) > options_.surface_frames) {
+    surface_free_.pop_front();
+  }
+}
+
+bool TurnCarry::SurfaceLeavesTurnFree() const {
+  if (surface_free_.empty()) return false;
+  const auto free = std::count(surface_free_.begin(), surface_free_.end(), true);
+  return free >= options_.min_free_share * static_cast<double>(surface_free_.size());
 }
 
 Rigid3 TurnCarry::Carry(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot) const {

@@ -37,6 +37,11 @@ struct TurnCarryOptions {
   int window_frames = 20;
   double recognise_deg = 40.0;
   double min_consistency = 0.7;
+  /// A frame's turn counts at most this much towards recognising it, degrees: a hand turns a
+  /// held object a few degrees a frame (the scripted grasps 2-4° at 30 frames/s), but swings
+  /// back faster, up to 12° a frame — and a swing back whose lifted fingers were taken for
+  /// contacts for six frames was recognised as the turn on a generated egg-shaped object.
+  double recognise_max_frame_deg = 5.0;
   /// The hand turns on in a frame where its turn about the recognised axis is forward in that
   /// frame and on average over the last this many frames (one frame's fitting noise is not a
   /// stroke).
@@ -44,6 +49,12 @@ struct TurnCarryOptions {
   /// A hand that turns farther than this in one frame was refitted rather than followed (a
   /// fit that flipped, a search): its motion says nothing of the object's, degrees.
   double max_frame_turn_deg = 15.0;
+  /// The hand carries only the turn of an object whose surface leaves it free: where at least
+  /// `min_free_share` of the last `surface_frames` frames whose free directions ICP judged
+  /// had one (IcpResult::free_directions). Balls, bottles and the pin: all of them; boxes and
+  /// cubes: none but where a face is seen alone (at most 47 % of 30 frames in eleven turns).
+  int surface_frames = 30;
+  double min_free_share = 0.8;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -71,6 +82,10 @@ class TurnCarry {
   /// After the frame: whether its contacts moved the object (the frames the one-way turn is
   /// recognised from).
   void Learn(bool contacts_used);
+  /// After ICP: how many directions the surface left free (-1: not judged, ignored).
+  void ObserveSurface(int free_directions);
+  /// Whether the surface has been leaving a direction free (see `min_free_share`).
+  bool SurfaceLeavesTurnFree() const;
   /// The object's previous pose carried by this frame's turn (after Judge returned kOn) about
   /// `pivot` (camera frame), and the angle, radians.
   Rigid3 Carry(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot) const;
@@ -92,6 +107,8 @@ class TurnCarry {
   std::deque<Eigen::Vector3d> contact_turns_;
   // The hand's turn about the axis in the last frames (radians; cleared where it is unknown).
   std::deque<double> along_axis_;
+  // Whether ICP found a free direction, in the last frames where it judged.
+  std::deque<bool> surface_free_;
   double carried_rad_ = 0;
 };
 

@@ -90,6 +90,42 @@ TEST(TurnCarryTest, BackAndForthOrTurnsWithoutContactsAreNeverRecognised) {
   EXPECT_EQ(wiggled.Judge(HandTurnBy(3, axis), Rigid3()), HandTurn::kUnknown);
 }
 
+TEST(TurnCarryTest, AFastSwingAloneIsNotTakenForTheTurn) {
+  // Six frames of a swing back at 12° a frame whose lifted fingers were taken for contacts
+  // (72°): each counts 5°, 30° in all, short of the 40° that recognise a turn. Twelve frames
+  // of the same swing would be (60°): what keeps it out is that a swing is short.
+  const Eigen::Vector3d axis(0, 1, 0);
+  TurnCarry carry;
+  for (int i = 0; i < 6; ++i) {
+    carry.Judge(HandTurnBy(-12, axis), Rigid3());
+    carry.Learn(true);
+  }
+  EXPECT_FALSE(carry.recognised());
+  for (int i = 0; i < 6; ++i) {
+    carry.Judge(HandTurnBy(-12, axis), Rigid3());
+    carry.Learn(true);
+  }
+  EXPECT_TRUE(carry.recognised());
+}
+
+TEST(TurnCarryTest, OnlyASurfaceThatKeepsLeavingATurnFreeIsCarried) {
+  TurnCarry carry;
+  EXPECT_FALSE(carry.SurfaceLeavesTurnFree()) << "nothing judged yet";
+  // A cube: a face seen alone leaves a direction free now and then.
+  for (int i = 0; i < 30; ++i) carry.ObserveSurface(i % 4 == 0 ? 2 : 0);
+  EXPECT_FALSE(carry.SurfaceLeavesTurnFree());
+  // A bottle: its turn about the axis, every frame (frames ICP did not judge do not count).
+  for (int i = 0; i < 30; ++i) {
+    carry.ObserveSurface(1);
+    carry.ObserveSurface(-1);
+  }
+  EXPECT_TRUE(carry.SurfaceLeavesTurnFree());
+  for (int i = 0; i < 6; ++i) carry.ObserveSurface(0);
+  EXPECT_TRUE(carry.SurfaceLeavesTurnFree()) << "24 of the last 30";
+  carry.ObserveSurface(0);
+  EXPECT_FALSE(carry.SurfaceLeavesTurnFree()) << "23 of the last 30";
+}
+
 TEST(TurnCarryTest, BadOptionsAreRefused) {
   TurnCarryOptions options;
   options.min_consistency = 0;
