@@ -60,6 +60,9 @@ HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3
       std::accumulate(along_axis_.begin(), along_axis_.end(), 0.0) / along_axis_.size();
   if (along > 0 && mean > 0) {
     carried_rad_ = along;
+    // The axis follows the hand's turns on (their wobble about other axes averages out).
+    turned_on_ += *turn_;
+    axis_ = turned_on_.normalized();
     return HandTurn::kOn;
   }
   return HandTurn::kBack;
@@ -87,6 +90,7 @@ void TurnCarry::Recognise() {
   if (net_deg >= options_.recognise_deg && net.norm() >= options_.min_consistency * travelled) {
     recognised_ = true;
     axis_ = net.normalized();
+    turned_on_ = net;
     contact_turns_.clear();
   }
 }

@@ -92,7 +92,8 @@ class TurnCarry {
   double carried_rad() const { return carried_rad_; }
 
   bool recognised() const { return recognised_; }
-  /// The recognised turn's axis in the object frame (unit; zero until recognised).
+  /// The recognised turn's axis in the object frame (unit; zero until recognised): the
+  /// direction of the hand's turns that recognised it and of every turn on since.
   const Eigen::Vector3d& axis() const { return axis_; }
 
  private:
@@ -101,6 +102,8 @@ class TurnCarry {
   TurnCarryOptions options_;
   bool recognised_ = false;
   Eigen::Vector3d axis_ = Eigen::Vector3d::Zero();
+  // The hand's turns that recognised the axis and every turn on since (object frame).
+  Eigen::Vector3d turned_on_ = Eigen::Vector3d::Zero();
   // This frame's hand turn in the object frame (rotation vector, radians), when there is one.
   std::optional<Eigen::Vector3d> turn_;
   // The hand's turns of the last frames whose contacts moved the object (object frame).
