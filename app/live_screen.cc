@@ -21,7 +21,7 @@ const cv::Scalar kGood(110, 220, 110), kDoubt(250, 200, 70), kBad(250, 100, 90);
 
 // A state word's colour: green when all is well, amber when in doubt or paused, red when lost.
 cv::Scalar StateColour(const std::string& state) {
-  if (state == "tracked" || state == "registered") return kGood;
+  if (state == "tracked" || state == "registered" || state == "turned by the hand") return kGood;
   if (state == "lost") return kBad;
   return kDoubt;
 }

@@ -35,7 +35,7 @@ const char* FramePacket::HandState() const {
 }
 
 const char* FramePacket::ObjectState() const {
-  if (Registered()) return "registered";
+  if (Registered()) return fusion.hand_carried_deg > 0 ? "turned by the hand" : "registered";
   return frame_error.empty() && !track.HasPose() ? "paused" : "lost";
 }
 

@@ -62,7 +62,8 @@ struct FramePacket {
   /// The hand's state for a person: "tracked", "doubtful" (a pose the data may not support),
   /// "lost" (no usable pose: no hand, a fit that diverged, an empty or malformed frame).
   const char* HandState() const;
-  /// The object's state for a person: "registered" (the frame was fused), "paused" (not fused:
+  /// The object's state for a person: "registered" (the frame was fused), "turned by the hand"
+  /// (fused, its free turn carried by the hand's: fusion/turn_carry.h), "paused" (not fused:
   /// no hand pose to go by), "lost" (not fused: the registration failed).
   const char* ObjectState() const;
 };

@@ -1,5 +1,5 @@
 // The object stage's correspondence sources: which the options turn on, in the registration's
-// order, and what each found per frame.
+// order, and what each found per frame; the object's state for the status line.
 
 #include "app/scan_stages.h"
 
@@ -57,6 +57,15 @@ TEST(ScanStagesTest, EachSourcesMatchesAreCountedPerFrame) {
       EXPECT_EQ(packet.matches[1].second, 0);
     }
   }
+}
+
+TEST(ScanStagesTest, TheObjectsStateSaysWhenTheHandTurnedIt) {
+  FramePacket packet;
+  EXPECT_STREQ(packet.ObjectState(), "paused") << "no hand pose, not fused";
+  packet.fusion.status = fusion::FusionStatus::kFused;
+  EXPECT_STREQ(packet.ObjectState(), "registered");
+  packet.fusion.hand_carried_deg = 2.5;
+  EXPECT_STREQ(packet.ObjectState(), "turned by the hand");
 }
 
 }  // namespace
