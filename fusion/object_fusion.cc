@@ -168,6 +168,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   UpdateContactNoise(contacts, step, &result);
   Integrate(input, object, pose, &result);
   UpdateAnchors(contacts, pose);
+  if (result.icp.ok) pivot_in_object_ = pose.Inverse() * result.icp.pivot;
   turn_carry_.Learn(result.ContactsUsed());
   return finish(FusionStatus::kFused);
 }
@@ -290,7 +291,6 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     surface_left_free_ = result->icp.free_directions != 0;
     turn_carry_.ObserveSurface(result->icp.free_directions);
     *pose = result->icp.cam_from_volume;
-    pivot_in_object_ = pose->Inverse() * result->icp.pivot;
     return true;
   }
   return result->pairwise.ok;
