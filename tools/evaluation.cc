@@ -279,6 +279,39 @@ ContactUse CompareContactUse(const fs::path& gt_dir, const std::vector<FrameCont
   return use;
 }
 
+GraspTips CompareGraspTips(const fs::path& gt_dir, const fs::path& tracked_csv,
+                           const std::vector<double>& within_mm) {
+  const auto touches = ReadTouches(gt_dir / "contacts.csv");
+  const std::array<int, 5> true_tip = FingertipJoints(gt_dir / "hand_joints.csv");
+  const std::array<int, 5> tracked_tip = FingertipJoints(tracked_csv);
+  std::map<std::int64_t, std::vector<Eigen::Vector3d>> truth, tracked;
+  for (auto& row : tracker::ReadHandJointsCsv(gt_dir / "hand_joints.csv"))
+    truth[row.frame] = std::move(row.joints_mm);
+  for (auto& row : tracker::ReadHandJointsCsv(tracked_csv))
+    tracked[row.frame] = std::move(row.joints_mm);
+  GraspTips tips{0, within_mm, std::vector<double>(within_mm.size(), 0.0)};
+  for (const auto& [frame, contacts] : touches) {
+    const int touching =
+        static_cast<int>(std::count(contacts.touch.begin(), contacts.touch.end(), true));
+    const auto true_joints = truth.find(frame);
+    if (touching < 2 || true_joints == truth.end()) continue;
+    ++tips.grasp_frames;
+    const auto fitted = tracked.find(frame);
+    if (fitted == tracked.end()) continue;
+    // Two touching fingers are within any distance at or above the second smallest error.
+    std::vector<double> errors;
+    for (int f = 0; f < 5; ++f) {
+      if (!contacts.touch[f]) continue;
+      errors.push_back(
+          (fitted->second.at(tracked_tip[f]) - true_joints->second.at(true_tip[f])).norm());
+    }
+    std::sort(errors.begin(), errors.end());
+    for (size_t k = 0; k < within_mm.size(); ++k) tips.share[k] += errors[1] <= within_mm[k];
+  }
+  for (double& share : tips.share) share /= std::max(1, tips.grasp_frames);
+  return tips;
+}
+
 fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const TriangleMesh& scan,
                                            const std::vector<StampedPose>& trajectory) {
   if (trajectory.empty()) throw InputError("no registered frame to align the scan by");

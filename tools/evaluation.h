@@ -117,6 +117,21 @@ struct ContactUse {
 ContactUse CompareContactUse(const std::filesystem::path& gt_dir,
                              const std::vector<FrameContactUse>& frames, double false_mm = 3.0);
 
+/// How near the tracker put the fingertips that grasp (gt/contacts.csv: the frames where the
+/// truth has at least two touching): per distance in `within_mm`, the share of those frames in
+/// which at least two of the touching fingers' tips in `tracked_csv` (a scan's or the tracker's
+/// hand_joints.csv) lie within it of the truth's (gt/hand_joints.csv). A contact is found only
+/// where the fitted fingertip is near the object, so this bounds the contact recall. A frame the
+/// tracked file lacks counts as not within. Throws ihs::InputError for unreadable files.
+struct GraspTips {
+  int grasp_frames = 0;
+  std::vector<double> within_mm;
+  std::vector<double> share;  ///< One per `within_mm`.
+};
+GraspTips CompareGraspTips(const std::filesystem::path& gt_dir,
+                           const std::filesystem::path& tracked_csv,
+                           const std::vector<double>& within_mm = {6.0, 10.0, 15.0});
+
 /// The pixels gt/labels/<index>.png (the generator's labels) marks as the object, row-major,
 /// 1 where it is; empty when the file is missing or not `width` × `height`.
 std::vector<std::uint8_t> TruthObjectPixels(const std::filesystem::path& gt_dir, std::int64_t index,

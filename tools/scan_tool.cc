@@ -217,6 +217,15 @@ nlohmann::json Evaluate(const Args& args, const std::string& object,
       "contacts used had no fingertip within 3 mm (%.0f %%)\n",
       use.used_in_grasp, use.grasp_frames, 100 * use.recall, use.false_frames, use.used_frames,
       100 * use.false_share);
+  // Contacts are found only where the fitted fingertips are near the object: how near they were.
+  const ihs::eval::GraspTips tips =
+      ihs::eval::CompareGraspTips(args.gt, fs::path(args.out) / "hand_joints.csv");
+  std::printf(
+      "fitted fingertips where the truth grasps: two touching ones within 6 / 10 / 15 mm of the "
+      "true ones in %.0f / %.0f / %.0f %% of those %d frames\n",
+      100 * tips.share[0], 100 * tips.share[1], 100 * tips.share[2], tips.grasp_frames);
+  evaluation["grasp_tips"] = {
+      {"grasp_frames", tips.grasp_frames}, {"within_mm", tips.within_mm}, {"share", tips.share}};
   evaluation["contacts"] = {{"grasp_frames", use.grasp_frames},
                             {"used_in_grasp", use.used_in_grasp},
                             {"recall", use.recall},

@@ -20,6 +20,7 @@
 #include "sensor/tum_directory.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
+#include "tracker/hand_joints_io.h"
 
 namespace ihs::eval {
 namespace {
@@ -160,6 +161,56 @@ TEST_F(EvaluationTest, ContactUseIsCountedAgainstTheTruesGraspsAndDistances) {
   EXPECT_LE(CompareContactUse(Gt(), all).false_frames, far);  // 3 mm: fewer are that far.
   ASSERT_GT(finger_far[finger], far);
   EXPECT_EQ(CompareContactUse(Gt(), one_finger, 1.0).false_frames, finger_far[finger]);
+}
+
+TEST_F(EvaluationTest, GraspingFingertipsAreJudgedAgainstTheTruths) {
+  // The truth's own joints as the tracker's: every grasping frame within any distance.
+  const std::filesystem::path truth_csv = Gt() / "hand_joints.csv";
+  const GraspTips exact = CompareGraspTips(Gt(), truth_csv);
+  ASSERT_GT(exact.grasp_frames, 5);
+  ASSERT_EQ(exact.share.size(), 3u);
+  for (double share : exact.share) EXPECT_EQ(share, 1.0);
+
+  // Every joint 8 mm off along x, and the last frame missing: within 10 and 15 mm but not 6,
+  // and the missing frame counts against.
+  std::vector<tracker::HandJointsRow> rows = tracker::ReadHandJointsCsv(truth_csv);
+  rows.pop_back();
+  for (auto& row : rows) {
+    for (auto& joint : row.joints_mm) joint.x() += 8.0;
+  }
+  std::ifstream header_in(truth_csv);
+  std::string header;
+  std::getline(header_in, header);
+  // The bones, from the header's "<bone>_end_x" columns (joint 0 is the root's start).
+  std::vector<std::string> bones;
+  std::stringstream columns(header);
+  int column = 0;
+  for (std::string name; std::getline(columns, name, ','); ++column) {
+    if (column >= 4 && (column - 1) % 3 == 0) bones.push_back(name.substr(0, name.size() - 6));
+  }
+  ASSERT_EQ(bones.size() + 1, rows.front().joints_mm.size());
+  const test::TempDir tracked;
+  tracker::WriteHandJointsCsv(tracked.path() / "hand_joints.csv", bones, rows);
+  const GraspTips off = CompareGraspTips(Gt(), tracked.path() / "hand_joints.csv");
+  EXPECT_EQ(off.grasp_frames, exact.grasp_frames);
+  EXPECT_EQ(off.share[0], 0.0);
+  // Was the last frame a grasp? Then it is the one not within.
+  const auto touching_last = [&] {
+    std::ifstream in(Gt() / "contacts.csv");
+    std::string line, last;
+    while (std::getline(in, line)) last = line;
+    std::stringstream fields(last);
+    std::vector<double> values;
+    for (std::string field; std::getline(fields, field, ',');) values.push_back(std::stod(field));
+    int touching = 0;
+    for (int f = 0; f < 5; ++f) touching += values[2 + f] > 0.5;
+    return touching;
+  }();
+  const double expected =
+      touching_last >= 2 ? static_cast<double>(exact.grasp_frames - 1) / exact.grasp_frames : 1.0;
+  EXPECT_NEAR(off.share[1], expected, 1e-12);
+  EXPECT_NEAR(off.share[2], expected, 1e-12);
+  EXPECT_THROW(CompareGraspTips(Gt(), tracked.path() / "missing.csv"), InputError);
 }
 
 TEST_F(EvaluationTest, TheShownSurfaceGrowsWithTheFramesThatShowIt) {
