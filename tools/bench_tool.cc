@@ -21,6 +21,7 @@
 #include "render/offscreen_renderer.h"
 #include "tools/bench/bench_run.h"
 #include "tools/bench/open3d_baseline.h"
+#include "tools/bench/open3d_peer.h"
 #include "tools/bench/report.h"
 
 namespace {
@@ -33,7 +34,16 @@ struct Args {
   int frames = 0;
   bool quick = false, no_open3d = false, no_app = false, no_pictures = false, quiet = false;
   std::string command;
+  // The benchmark's own child process for one Open3D baseline (tools/bench/open3d_peer.h).
+  std::string peer, peer_case, peer_out;
 };
+
+// What the program does as an Open3D peer: one baseline over one case, its results in files.
+int RunPeer(const Args& args) {
+  ihs::bench::RunOpen3dPeerJob(
+      {{}, args.peer_case, ihs::bench::Open3dTrackingNamed(args.peer), args.peer_out});
+  return ihs::kExitOk;
+}
 
 int Run(const Args& args) {
   namespace bench = ihs::bench;
@@ -74,6 +84,8 @@ int Run(const Args& args) {
   run.work =
       args.work.empty() ? fs::temp_directory_path() / "inhandscan-bench" : fs::path(args.work);
   run.open3d = !args.no_open3d;
+  // Each Open3D baseline runs in a child process: this program, started anew.
+  run.open3d_program = fs::read_symlink("/proc/self/exe");
   run.quiet = args.quiet;
   if (!args.no_app) run.app = args.app.empty() ? fs::path(IHS_INHANDSCAN_PATH) : fs::path(args.app);
   if (!run.app.empty() && !fs::exists(run.app))
@@ -132,6 +144,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-app", args.no_app, "do not time the application");
   app.add_flag("--no-pictures", args.no_pictures, "no mesh pictures (needs no OSMesa)");
   app.add_flag("-q,--quiet", args.quiet, "print only the report's path");
+  // Hidden (no group): how the benchmark runs an Open3D baseline in a process of its own.
+  app.add_option("--open3d-peer", args.peer)->group("");
+  app.add_option("--peer-case", args.peer_case)->group("");
+  app.add_option("--peer-out", args.peer_out)->group("");
   if (const auto done = ihs::ParseCommandLine(app, argc, argv)) return *done;
   // The command quoted in the report: the wrapper's when it says so (tools/bench.sh), else ours.
   std::ostringstream command;
@@ -141,6 +157,6 @@ int main(int argc, char** argv) {
   args.command = wrapper && *wrapper ? wrapper : command.str();
   return ihs::RunReportingErrors("inhandscan-bench", [&] {
     ihs::SetUpLogging(ihs::ParseLogLevel("warn"), args.quiet);
-    return Run(args);
+    return args.peer.empty() ? Run(args) : RunPeer(args);
   });
 }

@@ -16,6 +16,7 @@
 #include "tests/test_util.h"
 #include "tools/bench/bench_run.h"
 #include "tools/bench/open3d_baseline.h"
+#include "tools/bench/open3d_peer.h"
 #include "tools/bench/plot.h"
 #include "tools/bench/report.h"
 #include "tools/synth/object_shape.h"
@@ -331,6 +332,70 @@ TEST(Open3dBaselineTest, FrameToModelLeavesOutAFrameItCannotTrack) {
 
 // Sessions cut to a number of frames leave half the sphere unseen, so the sphere's whole session
 // comes as a case of its own for the volume; uncut sessions are whole already.
+// A stand-in for the benchmark's peer process: a shell script with `body`, executable.
+std::filesystem::path PeerScript(const test::TempDir& dir, const std::string& body) {
+  const std::filesystem::path script = dir / "peer.sh";
+  std::ofstream(script) << "#!/bin/sh\n" << body;
+  std::filesystem::permissions(script, std::filesystem::perms::owner_all);
+  return script;
+}
+
+// Why RunOpen3dPeer failed with the peer `body` as `tracking` ("" when it did not).
+std::string PeerFailure(const test::TempDir& dir, const std::string& body,
+                        Open3dTracking tracking) {
+  try {
+    RunOpen3dPeer({PeerScript(dir, body), dir.path(), tracking, dir / "out"});
+  } catch (const std::runtime_error& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// A peer that Open3D aborts, or that exits with an error, is a failure naming the method and
+// the last line it printed — not the end of the benchmark.
+TEST(Open3dPeerTest, APeerThatDiesIsAFailureWithItsReason) {
+  const test::TempDir dir;
+  const std::string aborted = PeerFailure(
+      dir, "echo working\necho 'Internal error: GetVoxelAt returns nullptr'\nkill -ABRT $$\n",
+      Open3dTracking::kFrameToModel);
+  EXPECT_NE(aborted.find("open3d-f2m died of signal 6"), std::string::npos) << aborted;
+  EXPECT_NE(aborted.find("GetVoxelAt returns nullptr"), std::string::npos) << aborted;
+  const std::string failed =
+      PeerFailure(dir, "echo 'bad frame' >&2\nexit 3\n", Open3dTracking::kFrameToFrame);
+  EXPECT_NE(failed.find("open3d failed (exit status 3): bad frame"), std::string::npos) << failed;
+  // Exits well but writes nothing: an error too.
+  EXPECT_NE(PeerFailure(dir, "exit 0\n", Open3dTracking::kFrameToFrame), "");
+}
+
+// What a peer writes comes back as its result; the arguments name the method, case and folder.
+TEST(Open3dPeerTest, APeersFilesAreItsResult) {
+  const test::TempDir dir;
+  // $2: the method, $4: the case, $6: the output folder.
+  const std::filesystem::path writes = PeerScript(
+      dir, "[ \"$1 $2 $3 $4 $5\" = \"--open3d-peer open3d-f2m --peer-case " + dir.path().string() +
+               " --peer-out\" ] || exit 9\n"
+               "printf 'ply\\nformat ascii 1.0\\nelement vertex 3\\nproperty float x\\n"
+               "property float y\\nproperty float z\\nelement face 1\\n"
+               "property list uchar int vertex_indices\\nend_header\\n0 0 0\\n1 0 0\\n0 1 0\\n"
+               "3 0 1 2\\n' > \"$6/raw.ply\"\n"
+               "printf '1.0 1 2 3 0 0 0 1\\n1.5 1 2 4 0 0 0 1\\n' > \"$6/trajectory.txt\"\n"
+               "echo '{\"frames\": 3, \"odometry_failures\": 1, \"empty_frames\": 0, "
+               "\"odometry_ms\": 2.5, \"integrate_ms\": 1.5, \"raycast_ms\": 0.5}' "
+               "> \"$6/peer.json\"\n");
+  const Open3dBaselineResult result =
+      RunOpen3dPeer({writes, dir.path(), Open3dTracking::kFrameToModel, dir / "out"});
+  EXPECT_EQ(result.frames, 3);
+  EXPECT_EQ(result.odometry_failures, 1);
+  EXPECT_DOUBLE_EQ(result.odometry_ms, 2.5);
+  EXPECT_DOUBLE_EQ(result.raycast_ms, 0.5);
+  ASSERT_EQ(result.trajectory.size(), 2u);
+  EXPECT_DOUBLE_EQ(result.trajectory[1].transform.translation().z(), 4.0);
+  EXPECT_EQ(result.raw.vertices.size(), 3u);
+  EXPECT_EQ(result.raw.faces.size(), 1u);
+  EXPECT_EQ(Open3dTrackingNamed("open3d-f2m"), Open3dTracking::kFrameToModel);
+  EXPECT_THROW(Open3dTrackingNamed("ours"), std::invalid_argument);
+}
+
 TEST(BenchCasesTest, CutSessionsComeWithTheSpheresWholeSession) {
   auto names = [](const std::vector<BenchCase>& cases) {
     std::vector<std::string> out;

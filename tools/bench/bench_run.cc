@@ -15,6 +15,7 @@
 #include "core/stopwatch.h"
 #include "fusion/surface_mesh.h"
 #include "tools/bench/open3d_baseline.h"
+#include "tools/bench/open3d_peer.h"
 #include "tools/evaluation.h"
 #include "tools/synth/objects.h"
 #include "tools/synth/sequence.h"
@@ -113,12 +114,6 @@ void GenerateIfNeeded(const BenchCase& c, const fs::path& dir, bool quiet) {
   std::ofstream(key_file) << key.dump();
 }
 
-// One of Open3D's baselines during the pass over the frames.
-struct Open3dRunner {
-  std::string name;
-  std::unique_ptr<Open3dBaseline> baseline;
-};
-
 // One method's stage and log during the pass over the frames.
 struct Runner {
   Method method;
@@ -151,20 +146,17 @@ void MeshAndMeasure(const BenchCase& c, const fs::path& gt_dir, const fusion::Mo
 }
 
 // The frames' pass: the hand tracked once, each method's stage and record on a copy of the
-// packet, Open3D's baselines on the frame with the truth's object pixels.
+// packet.
 void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& hand,
                 const std::vector<tracker::HandJointsRow>& gt_joints, std::vector<Runner>& runners,
-                std::vector<Open3dRunner>& open3d, bool quiet, CaseResult& out) {
+                bool quiet, CaseResult& out) {
   double joint_error_sum = 0, track_ms = 0, mask_ms = 0;
   int frames = 0;
   eval::ShownSurface shown(out.gt_dir, scan.intrinsics());
-  std::vector<std::uint8_t> no_object;  // For frames without labels.
   scan.Run(hand, [&](app::FramePacket& packet) {
-    // The truth's object pixels, read once: what the frame showed, and Open3D's masks.
+    // What the frame showed of the object.
     const Frame& frame = *packet.frame;
-    const std::vector<std::uint8_t> truth_object =
-        eval::TruthObjectPixels(out.gt_dir, frame.index, frame.width, frame.height);
-    shown.Add(frame, truth_object);
+    shown.Add(frame, eval::TruthObjectPixels(out.gt_dir, frame.index, frame.width, frame.height));
     track_ms += packet.track.milliseconds;
     mask_ms += packet.mask_ms;
     const std::int64_t index = frame.index;
@@ -177,10 +169,6 @@ void ScanFrames(const BenchCase& c, app::SequentialScan& scan, app::HandStage& h
       app::FramePacket copy = packet;
       app::ScanObject(*runner.stage, *runner.record, copy);
     }
-    // Without labels the baselines get no object pixels.
-    if (truth_object.empty()) no_object.assign(frame.PixelCount(), 0);
-    const std::vector<std::uint8_t>& keep = truth_object.empty() ? no_object : truth_object;
-    for (Open3dRunner& baseline : open3d) baseline.baseline->Process(frame, keep);
     ++frames;
     if (!quiet && frames % 200 == 0)
       std::fprintf(stderr, "inhandscan-bench: %s frame %d\n", c.name.c_str(), frames);
@@ -231,14 +219,15 @@ MethodResult FinishMethod(const BenchCase& c, const fs::path& dir, const CaseRes
   return result;
 }
 
-// An Open3D baseline's result: its trajectory, times and meshes.
-MethodResult FinishOpen3d(const BenchCase& c, const CaseResult& out, Open3dRunner& open3d) {
+// An Open3D baseline's result, run in its own process (open3d_peer.h): its trajectory, times
+// and meshes, or why it failed.
+MethodResult RunOpen3d(const BenchCase& c, const fs::path& dir, const CaseResult& out,
+                       Open3dTracking tracking, const fs::path& program) {
   MethodResult result;
-  result.method = open3d.name;
+  result.method = Open3dMethodName(tracking);
   result.frames = out.frames;
   try {
-    Open3dBaselineResult o3d = open3d.baseline->Finish();
-    open3d.baseline.reset();
+    Open3dBaselineResult o3d = RunOpen3dPeer({program, dir, tracking, dir / result.method});
     result.registered = static_cast<int>(o3d.trajectory.size());
     result.trajectory = std::move(o3d.trajectory);
     result.measures["ms_per_frame"] = {
@@ -303,19 +292,16 @@ CaseResult RunCase(const BenchCase& c, const std::vector<Method>& methods,
     runner.record = std::make_unique<app::ScanRecord>(hand.BoneNames(), hand.AngleNames());
     runners.push_back(std::move(runner));
   }
-  std::vector<Open3dRunner> open3d;
-  if (options.open3d && Open3dAvailable()) {
-    for (Open3dTracking tracking : {Open3dTracking::kFrameToFrame, Open3dTracking::kFrameToModel}) {
-      Open3dBaselineOptions o3d;
-      o3d.tracking = tracking;
-      open3d.push_back(
-          {Open3dMethodName(tracking), std::make_unique<Open3dBaseline>(scan.intrinsics(), o3d)});
-    }
-  }
+  const bool open3d = options.open3d && Open3dAvailable();
+  if (open3d && options.open3d_program.empty())
+    throw std::invalid_argument("bench: the Open3D baselines need RunOptions::open3d_program");
 
-  ScanFrames(c, scan, hand, gt_joints, runners, open3d, options.quiet, out);
+  ScanFrames(c, scan, hand, gt_joints, runners, options.quiet, out);
   for (Runner& runner : runners) out.methods.push_back(FinishMethod(c, dir, out, runner));
-  for (Open3dRunner& baseline : open3d) out.methods.push_back(FinishOpen3d(c, out, baseline));
+  if (open3d) {
+    for (Open3dTracking tracking : {Open3dTracking::kFrameToFrame, Open3dTracking::kFrameToModel})
+      out.methods.push_back(RunOpen3d(c, dir, out, tracking, options.open3d_program));
+  }
   if (!options.app.empty()) RunApplication(c, dir, options, out);
   return out;
 }

@@ -106,8 +106,10 @@ struct CaseResult {
 
 struct RunOptions {
   std::filesystem::path work;  ///< Sequences (cached) and per-method outputs.
-  /// Run the Open3D baselines (frame to frame, frame to model) when built with Open3D.
+  /// Run the Open3D baselines (frame to frame, frame to model) when built with Open3D, each in
+  /// a process of its own: `open3d_program` (open3d_peer.h; inhandscan-bench runs itself).
   bool open3d = true;
+  std::filesystem::path open3d_program;
   /// `inhandscan` to time the application with (empty: skip).
   std::filesystem::path app;
   bool quiet = false;
