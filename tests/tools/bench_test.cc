@@ -505,6 +505,32 @@ TEST(BenchToolTest, QuickReportHasEveryTableFileAndMethod) {
 
 // A method that lost the object (a mesh of the scene: a diameter of 268 million mm) is reported
 // as lost, not by its numbers, and is left out of the paper sessions' mean, which says so.
+// A method that failed (an Open3D peer Open3D aborted) has no measures: its cells say "failed"
+// and results.csv gives the reason; the rest of the report is written.
+TEST(ReportTest, AFailedMethodIsAFailedCellWithItsReason) {
+  const test::TempDir dir;
+  CaseResult session;
+  session.bench_case = {"004-sphere-whole", "sphere", "recorded:x", false, 0, true};
+  MethodResult ours;
+  ours.method = "ours";
+  ours.ok = true;
+  ours.frames = ours.registered = 300;
+  ours.measures["chamfer_mm"] = 0.5;
+  ours.measures["completeness"] = 0.9;
+  MethodResult aborted;
+  aborted.method = "open3d-f2m";
+  aborted.frames = 300;
+  aborted.error = "open3d-f2m died of signal 6 (Aborted): GetVoxelAt returns nullptr";
+  session.methods = {ours, aborted};
+  ReportOptions options;
+  options.out = dir.path();
+  options.mesh_pictures = false;
+  const std::string md = WriteReport({session}, {{"ours"}}, options);
+  EXPECT_NE(md.find("failed"), std::string::npos) << md;
+  const std::string csv = test::ReadFileString(dir / "benchmarks" / "results.csv");
+  EXPECT_NE(csv.find("open3d-f2m died of signal 6 (Aborted)"), std::string::npos) << csv;
+}
+
 TEST(ReportTest, AMethodThatLostTheObjectIsReportedAsLost) {
   const test::TempDir dir;
   CaseResult session;

@@ -80,7 +80,7 @@ struct MethodResult {
   int frames = 0, registered = 0;
   /// Dimensions, volume, pairwise error, trajectory drift, Chamfer (eval::ReportScan's JSON)
   /// plus "ms_per_frame", "export_ms", skip reasons.
-  nlohmann::json measures;
+  nlohmann::json measures = nlohmann::json::object();
   std::vector<StampedPose> trajectory;
   /// The meshes (object frame of the scan): TSDF surface smoothed, and watertight.
   TriangleMesh seen, watertight;
