@@ -102,6 +102,15 @@ void AddContactOptions(OptionRegistry& r, tracker::ContactOptions* contacts) {
   r.Add("tracker.contacts.reference_fingertip_vertices", &c.reference_fingertip_vertices,
         "fingertip vertex count min_vertices refers to (other templates scale it)");
   r.Add("tracker.contacts.min_bones", &c.min_bones, "contact bones wanted (paper: 2)");
+  r.Add("tracker.contacts.surface_mm", &c.surface_mm,
+        "a fingertip vertex this near the object's surface continued under it (a sphere or plane "
+        "fitted to the points around it) counts as touching, mm (0: off)");
+  r.Add("tracker.contacts.surface_patch_mm", &c.surface_patch_mm,
+        "object points within this of a fingertip's centre make its surface, mm");
+  r.Add("tracker.contacts.surface_min_points", &c.surface_min_points,
+        "fewest object points that make a fingertip's surface");
+  r.Add("tracker.contacts.surface_max_rms_mm", &c.surface_max_rms_mm,
+        "a fingertip's surface is continued only where its points lie this near it (RMS), mm");
 }
 
 void AddGraspHoldOptions(OptionRegistry& r, tracker::GraspHoldOptions* hold) {
