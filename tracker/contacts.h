@@ -95,7 +95,7 @@ class ContactDetector {
   std::vector<int> min_vertices_;  // Per end-effector, scaled to its vertex count.
 
   // Each vertex's distance to the object's surface continued under fingertip `e` (1e9 where
-  // the points around it are too few), mm.
+  // the points around it are too few or fit no sphere or plane), mm.
   std::vector<float> SurfaceDistances(size_t e, const std::vector<Eigen::Vector3f>& posed_vertices,
                                       const std::vector<Eigen::Vector3f>& object_points) const;
 };
