@@ -111,6 +111,13 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["visual_inliers"] = fused.pairwise.visual_inliers;
     }
     if (fused.icp_from_previous) entry["icp_from_previous"] = true;
+    if (fused.keyframe) entry["keyframe"] = true, ++keyframes_;
+    if (fused.loops > 0) entry["loops"] = fused.loops, loops_ += fused.loops;
+    if (fused.loop_correction_mm > 0) {
+      entry["loop_correction_mm"] = fused.loop_correction_mm;
+      entry["refuse_ms"] = fused.refuse_ms;
+      ++loop_corrections_;
+    }
     if (fused.icp.iterations > 0) {
       entry["icp_inliers"] = fused.icp.inliers;
       entry["icp_first_inliers"] = fused.icp.first_inliers;
@@ -156,6 +163,9 @@ nlohmann::json ScanRecord::Summary() const {
                             {"hand_turned_over_frames", turned_over_frames_},
                             {"held_grasp_frames", held_grasp_frames_},
                             {"icp_slid_frames", icp_slid_frames_},
+                            {"keyframes", keyframes_},
+                            {"loops", loops_},
+                            {"loop_corrections", loop_corrections_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},
                             {"fusion_status_counts", fusion_counts_},

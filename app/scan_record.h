@@ -70,6 +70,10 @@ class ScanRecord {
   std::int64_t held_grasp_frames_ = 0;
   // Frames whose ICP slid off what it started on (IcpOptions::min_kept_pair_fraction).
   std::int64_t icp_slid_frames_ = 0;
+  // Keyframes kept, loops closed and drift corrections made (keyframe_graph.h).
+  std::int64_t keyframes_ = 0;
+  std::int64_t loops_ = 0;
+  std::int64_t loop_corrections_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;
   std::int64_t hand_back_frames_ = 0;

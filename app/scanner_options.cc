@@ -187,6 +187,40 @@ void AddRegistrationOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
         "best-paired iterate is kept (0: off)");
 }
 
+void AddLoopClosureOptions(OptionRegistry& r, fusion::LoopClosureOptions* options) {
+  fusion::LoopClosureOptions& l = *options;
+  r.Add("fusion.loop_closure.enabled", &l.enabled,
+        "keep keyframes, register views seen again after a turn against them and correct the "
+        "drift (pose graph, model re-fused)");
+  r.Add("fusion.loop_closure.keyframe_turn_deg", &l.keyframe_turn_deg,
+        "a frame becomes a keyframe when the object turned this far since the last, degrees");
+  r.Add("fusion.loop_closure.max_keyframes", &l.max_keyframes, "keyframes kept at most");
+  r.Add("fusion.loop_closure.loop_min_gap", &l.loop_min_gap,
+        "a loop joins keyframes at least this many keyframes apart");
+  r.Add("fusion.loop_closure.loop_max_turn_deg", &l.loop_max_turn_deg,
+        "... whose views are within this turn of each other, degrees");
+  r.Add("fusion.loop_closure.loop_tries", &l.loop_tries,
+        "earlier keyframes registered per new keyframe at most");
+  r.Add("fusion.loop_closure.loop_agreement_mm", &l.loop_agreement_mm,
+        "a loop counts once another agrees with it on where the object is within this, mm");
+  r.Add("fusion.loop_closure.loop_pending_keyframes", &l.loop_pending_keyframes,
+        "... another of the same keyframe or of the next this many");
+  r.Add("fusion.loop_closure.icp_start_mm", &l.icp_start_mm,
+        "a loop's ICP pairs points this far apart at first, then half, then a quarter, mm");
+  r.Add("fusion.loop_closure.min_inlier_fraction", &l.min_inlier_fraction,
+        "a loop pairs at least this share of the new keyframe's points");
+  r.Add("fusion.loop_closure.max_rms_mm", &l.max_rms_mm, "... at this RMS at most, mm");
+  r.Add("fusion.loop_closure.max_correction_mm", &l.max_correction_mm,
+        "... and moves the chain's estimate by less than this, mm");
+  r.Add("fusion.loop_closure.refuse_min_mm", &l.refuse_min_mm,
+        "the model is re-fused when the solved graph moves a keyframe farther than this, mm");
+  r.Add("fusion.loop_closure.lever_mm", &l.graph.lever_mm,
+        "the pose graph weighs turns by how far they move points this far from the object's "
+        "origin, mm");
+  r.Add("fusion.loop_closure.robust_scale_mm", &l.graph.robust_scale_mm,
+        "scale of the chain edges' Cauchy loss, mm");
+}
+
 }  // namespace
 
 void AddScanOptions(OptionRegistry& r, ScanOptions* options) {
@@ -335,6 +369,7 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "views that must see through a point for it to be empty");
   r.Add("fusion.free_space.no_depth_is_empty", &u.free_space.no_depth_is_empty,
         "pixels without depth far from any with depth are rays that met nothing");
+  AddLoopClosureOptions(r, &u.loop_closure);
   AddTsdfOptions(r, options);
   AddRegistrationOptions(r, options);
 }

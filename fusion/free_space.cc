@@ -146,7 +146,7 @@ FreeSpace::FreeSpace(const CameraIntrinsics& intrinsics, FreeSpaceOptions option
 }
 
 bool FreeSpace::Observe(const Frame& frame, const std::array<int, 4>& object_box,
-                        const Rigid3& cam_from_object, const TriangleMesh* hand) {
+                        const Rigid3& cam_from_object, const TriangleMesh* hand, int stamp) {
   if (!options_.enabled || views() >= options_.max_views) return false;
   if (object_box[2] <= object_box[0] || object_box[3] <= object_box[1]) return false;
   // Turned far enough from every kept view: the relative rotation's angle θ has
@@ -158,6 +158,7 @@ bool FreeSpace::Observe(const Frame& frame, const std::array<int, 4>& object_box
     if (trace > min_trace) return false;
   }
   auto view = std::make_shared<DepthView>();
+  view->stamp = stamp;
   view->cam_from_object = cam_from_object;
   view->rotation = cam_from_object.rotation().cast<float>();
   view->translation = cam_from_object.translation().cast<float>();
@@ -181,6 +182,16 @@ bool FreeSpace::Observe(const Frame& frame, const std::array<int, 4>& object_box
   if (hand != nullptr) AddHandSpans(*hand, intrinsics_, view.get());
   views_.push_back(std::move(view));
   return true;
+}
+
+void FreeSpace::Repose(const std::function<Rigid3(int stamp)>& correction) {
+  for (auto& view : views_) {
+    auto moved = std::make_shared<DepthView>(*view);
+    moved->cam_from_object = view->cam_from_object * correction(view->stamp);
+    moved->rotation = moved->cam_from_object.rotation().cast<float>();
+    moved->translation = moved->cam_from_object.translation().cast<float>();
+    view = std::move(moved);
+  }
 }
 
 // The votes of the views on one point so far.

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -57,6 +58,8 @@ struct FreeSpaceOptions {
 struct DepthView {
   /// Depth value of a pixel whose ray met nothing (FreeSpaceOptions::no_depth_is_empty).
   static constexpr std::uint16_t kNothing = 0xFFFF;
+  /// The fused frame's number (ObjectFusion's count), for a loop closure's correction.
+  int stamp = 0;
   Rigid3 cam_from_object;
   /// The same in single precision, for the many points a bound projects.
   Eigen::Matrix3f rotation;
@@ -102,9 +105,13 @@ class FreeSpace {
   /// Considers a registered frame: its whole depth (hand and background included) seen from
   /// `cam_from_object`, the object's pixels inside `object_box` (u0, v0, u1, v1; exclusive
   /// ends), and the posed hand model (`hand`, camera frame, closed; null: none). Returns
-  /// whether it was kept.
+  /// whether it was kept. `stamp` numbers the frame (DepthView::stamp).
   bool Observe(const Frame& frame, const std::array<int, 4>& object_box,
-               const Rigid3& cam_from_object, const TriangleMesh* hand = nullptr);
+               const Rigid3& cam_from_object, const TriangleMesh* hand = nullptr, int stamp = 0);
+  /// Moves every view's object frame by `correction(stamp)` (new cam_from_object = old ·
+  /// correction): a loop closure corrected the poses it was seen from. Views shared with
+  /// earlier copies are copied, not changed.
+  void Repose(const std::function<Rigid3(int stamp)>& correction);
 
   /// How deep `point` (object frame, mm) lies inside space the views saw empty, clamped to
   /// [−limit, limit]: positive where at least `min_views` views saw through it by more than

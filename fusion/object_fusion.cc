@@ -31,6 +31,7 @@ void FusionOptions::Check() const {
   coverage.Check();
   turn_carry.Check();
   free_space.Check();
+  loop_closure.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -51,7 +52,8 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       coverage_(options_.coverage),
       free_space_(intrinsics, options_.free_space),
       contact_noise_mm_(options_.contact_noise_reference_mm),
-      turn_carry_(options_.turn_carry) {}
+      turn_carry_(options_.turn_carry),
+      keyframes_(intrinsics, options_.loop_closure, options_.icp) {}
 
 FusionResult ObjectFusion::Skip(std::string reason) const {
   FusionResult result;
@@ -238,7 +240,41 @@ void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& objec
   const auto integrate_start = SteadyClock::now();
   result->integrated_voxels = volume_.Integrate(object.frame, object.mask, intrinsics_, pose);
   result->integrate_ms = MillisecondsSince(integrate_start);
-  free_space_.Observe(object.frame, object.box, pose, input.hand);
+  free_space_.Observe(object.frame, object.box, pose, input.hand, fused_frames_);
+  CloseLoops(object, result);
+  ++fused_frames_;
+}
+
+void ObjectFusion::CloseLoops(const ObjectPixels& object, FusionResult* result) {
+  const KeyframeUpdate update =
+      keyframes_.Observe(object.frame, object.mask, object.box, cam_from_object_, fused_frames_);
+  result->keyframe = update.added;
+  result->loops = update.loops;
+  if (update.corrected) ApplyCorrection(update, result);
+}
+
+void ObjectFusion::ApplyCorrection(const KeyframeUpdate& update, FusionResult* result) {
+  const auto refuse_start = SteadyClock::now();
+  const std::vector<Keyframe>& keyframes = keyframes_.keyframes();
+  // This frame is the newest keyframe.
+  const Rigid3 moved = update.corrections.back();
+  cam_from_object_ = cam_from_object_ * moved;
+  result->cam_from_object = cam_from_object_;
+  result->loop_correction_mm = update.correction_mm;
+  const Rigid3 object_from_moved = moved.Inverse();
+  for (auto& [id, anchor] : anchors_) anchor.object_point = object_from_moved * anchor.object_point;
+  pivot_in_object_ = object_from_moved * pivot_in_object_;
+  free_space_.Repose(
+      [&](int stamp) { return KeyframeGraph::CorrectionAt(keyframes, update.corrections, stamp); });
+  volume_.Clear();
+  Frame canvas = Frame::Blank(intrinsics_.width, intrinsics_.height);
+  std::vector<std::uint8_t> mask(canvas.depth_mm.size(), 0);
+  for (const Keyframe& keyframe : keyframes) {
+    keyframe.PasteInto(&canvas, &mask);
+    volume_.Integrate(canvas, mask, intrinsics_, keyframe.cam_from_object);
+    keyframe.ClearFrom(&canvas, &mask);
+  }
+  result->refuse_ms = MillisecondsSince(refuse_start);
 }
 
 Rigid3 ObjectFusion::Register(const FusionInput& input, bool with_contacts,

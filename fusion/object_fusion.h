@@ -19,6 +19,7 @@
 #include "core/triangle_mesh.h"
 #include "fusion/free_space.h"
 #include "fusion/icp.h"
+#include "fusion/keyframe_graph.h"
 #include "fusion/model_contacts.h"
 #include "fusion/pairwise_registration.h"
 #include "fusion/tsdf_volume.h"
@@ -42,6 +43,8 @@ struct FusionOptions {
   /// The turn the hand carries where the surface leaves it free (turn_carry.h); it needs
   /// FusionInput::hand_motion.
   TurnCarryOptions turn_carry;
+  /// Keyframes, loops after a turn and the drift they correct (keyframe_graph.h).
+  LoopClosureOptions loop_closure;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -152,6 +155,13 @@ struct FusionResult {
   /// FusionOptions::contact_noise_reference_mm).
   double contact_residual_mm = 0;
   double contact_noise_mm = 0;
+  /// Whether this frame became a keyframe, how many loops it closed with earlier keyframes,
+  /// and, where they corrected the drift, by how much (mm at the pose graph's lever; the model
+  /// was re-fused from the keyframes and `cam_from_object` is the corrected pose).
+  bool keyframe = false;
+  int loops = 0;
+  double loop_correction_mm = 0;
+  double refuse_ms = 0;
   /// Whether ICP started from the previous pose won over the registration's (see
   /// FusionOptions::icp_retry_fraction).
   bool icp_from_previous = false;
@@ -187,6 +197,7 @@ class ObjectFusion {
   ModelSnapshot Snapshot() const { return {volume_.ExtractMesh(), free_space_}; }
   const FreeSpace& free_space() const { return free_space_; }
   const TsdfVolume& volume() const { return volume_; }
+  const KeyframeGraph& keyframes() const { return keyframes_; }
   bool started() const { return started_; }
   const FusionOptions& options() const { return options_; }
 
@@ -218,6 +229,11 @@ class ObjectFusion {
   // Takes `pose` as the object's, integrates the frame at it and keeps its free space.
   void Integrate(const FusionInput& input, const ObjectPixels& object, const Rigid3& pose,
                  FusionResult* result);
+  // Keeps the fused frame as a keyframe where it is one, and applies what its loops corrected.
+  void CloseLoops(const ObjectPixels& object, FusionResult* result);
+  // Re-fuses the model from the keyframes at their corrected poses and moves everything kept
+  // in the object frame (the pose, the views of free space, the anchors) by `update`.
+  void ApplyCorrection(const KeyframeUpdate& update, FusionResult* result);
   // The correspondences' motion applied to the previous pose (that pose where the registration
   // fails); `contacts` gets the contact pairs used (the model's included, anchors applied),
   // none without `with_contacts`.
@@ -281,6 +297,9 @@ class ObjectFusion {
   // The hand's vertices in the previous frame, when it was registered (else empty).
   std::vector<Eigen::Vector3f> previous_hand_;
   TurnCarry turn_carry_;
+  KeyframeGraph keyframes_;
+  // Frames fused so far (the stamp of keyframes and views).
+  int fused_frames_ = 0;
 };
 
 }  // namespace ihs::fusion

@@ -41,6 +41,17 @@ TsdfVolume::TsdfVolume(TsdfOptions options)
       voxels_(static_cast<size_t>(n_) * n_ * n_),
       touched_bits_((voxels_.size() + 63) / 64, 0) {}
 
+void TsdfVolume::Clear() {
+  for (int k = observed_lo_[2]; k <= observed_hi_[2]; ++k) {
+    for (int j = observed_lo_[1]; j <= observed_hi_[1]; ++j) {
+      const std::int64_t row = Index(observed_lo_[0], j, k);
+      std::fill_n(voxels_.begin() + row, observed_hi_[0] - observed_lo_[0] + 1, Voxel{});
+    }
+  }
+  observed_lo_ = {n_, n_, n_};
+  observed_hi_ = {-1, -1, -1};
+}
+
 Eigen::Vector3f TsdfVolume::Centre(int i, int j, int k) const {
   const double half = 0.5 * options_.size_mm;
   return Eigen::Vector3d(-half + (i + 0.5) * voxel_mm_, -half + (j + 0.5) * voxel_mm_,

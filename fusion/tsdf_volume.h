@@ -62,6 +62,9 @@ class TsdfVolume {
   int Integrate(const Frame& frame, const std::vector<std::uint8_t>& mask,
                 const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume);
 
+  /// Forgets every observation (a loop closure re-fuses the model from its keyframes).
+  void Clear();
+
   /// The model's surface seen from `cam_from_volume`: the first zero crossing along each ray.
   /// Only the pixels in `roi` (u0, v0, u1, v1, exclusive ends; all when empty) are cast. With
   /// `near_depth_mm` (per pixel, row-major), a ray is cast only where it is non-zero and only

@@ -140,6 +140,12 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
   if (const int slid = count(summary, "icp_slid_frames"); slid > 0)
     std::printf("  ICP slid off what it started on in %d frames: its best-paired iterate kept\n",
                 slid);
+  if (const int loops = count(summary, "loops"); loops > 0) {
+    std::printf(
+        "  loop closure: %d keyframes, %d loops with earlier ones, the drift corrected %d "
+        "times\n",
+        count(summary, "keyframes"), loops, count(summary, "loop_corrections"));
+  }
   if (const int carried = count(summary, "hand_carried_frames"),
       back = count(summary, "hand_back_frames");
       carried + back > 0) {

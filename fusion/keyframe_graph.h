@@ -1,0 +1,160 @@
+#pragma once
+// Online loop closure: a full turn brings the object back to views seen before, by then with
+// the drift of every frame since. This keeps keyframes (the object's depth every few degrees of
+// turn, and the pose it was fused at), registers each new keyframe against the earlier ones it
+// sees the same side of — the views themselves, not the model that the drift has smeared —
+// and, where such a loop disagrees with the chain of tracked poses, solves the pose graph over
+// all keyframes (pose_graph.h). ObjectFusion then re-fuses the model from the keyframes at their
+// corrected poses and carries on from the corrected pose (as Weise et al. 2011 close loops in
+// their in-hand scanner, with the keyframes re-fused instead of a deformed surfel model).
+//
+// A loop is taken only from a registration that fixes every direction: a ball or a bottle
+// turned about its axis looks the same from every side of the turn, so there its loop says
+// nothing about the turn and none is taken.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "core/camera_intrinsics.h"
+#include "core/frame.h"
+#include "core/rigid3.h"
+#include "fusion/icp.h"
+#include "fusion/pose_graph.h"
+#include "fusion/tsdf_volume.h"
+
+namespace ihs::fusion {
+
+/// Options of the loop closure (fusion.loop_closure.*; defaults: an object turned in one hand
+/// at 0.4–0.9 m, Kinect-class depth).
+struct LoopClosureOptions {
+  bool enabled = true;
+  /// A fused frame becomes a keyframe when the object has turned this far since the last one
+  /// (degrees): a full turn keeps about 360 / this many. The model is re-fused from them.
+  double keyframe_turn_deg = 6.0;
+  /// At most this many keyframes (each the object's depth and colour: 20–100 kB); later frames
+  /// are not kept and close no loop.
+  int max_keyframes = 400;
+  /// A loop joins two keyframes at least this many keyframes apart whose poses see the object
+  /// from within `loop_max_turn_deg` of each other; at most `loop_tries` of the nearest such
+  /// are registered per new keyframe.
+  int loop_min_gap = 6;
+  double loop_max_turn_deg = 25.0;
+  int loop_tries = 3;
+  /// A loop counts only once another loop agrees with it on where the object is, within
+  /// `loop_agreement_mm` (at the graph's lever; the two carried to one keyframe along the
+  /// chain): another of the same keyframe, or of one of the next `loop_pending_keyframes`. A
+  /// view that registers where it is not (a cube's faces are alike) rarely does so twice alike.
+  double loop_agreement_mm = 3.0;
+  int loop_pending_keyframes = 4;
+  /// The registration of a loop: ICP between the two keyframes' object points, pairs at most
+  /// this far apart at first (mm), halved twice (the drift of a turn is more than the 5 mm
+  /// of frame-to-frame ICP).
+  double icp_start_mm = 20.0;
+  /// It is a loop when at least this share of the new keyframe's points pair within the last
+  /// pass's distance, at this RMS at most (mm), and it moves the estimate by less than
+  /// `max_correction_mm` (at the graph's lever).
+  double min_inlier_fraction = 0.5;
+  double max_rms_mm = 1.5;
+  double max_correction_mm = 80.0;
+  /// The model is re-fused only when the solved graph moves some keyframe by more than this
+  /// (mm at the lever): less is the keyframe registration's own noise.
+  double refuse_min_mm = 1.5;
+  /// The chain's edges (the tracked motion between consecutive keyframes) are robust (one
+  /// frame that slid may carry the whole disagreement); the loops are not.
+  PoseGraphOptions graph;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// A kept view: the object's depth (and colour) in its crop and where the object was.
+struct Keyframe {
+  /// ObjectFusion's count of fused frames when it was taken.
+  int stamp = 0;
+  Rigid3 cam_from_object;
+  /// The crop: top-left pixel and size; depth (mm) where the object's mask was set, else 0;
+  /// colour (3 bytes a pixel) when the frame had any.
+  int u0 = 0, v0 = 0, width = 0, height = 0;
+  std::vector<std::uint16_t> depth_mm;
+  std::vector<std::uint8_t> rgb;
+  /// Every other pixel's point in each direction (camera frame, mm): what a loop registers.
+  std::vector<Eigen::Vector3f> points;
+
+  /// Writes its depth, colour and mask into full-size `frame` and `mask` (which must be
+  /// zero there), and ClearFrom takes them out again.
+  void PasteInto(Frame* frame, std::vector<std::uint8_t>* mask) const;
+  void ClearFrom(Frame* frame, std::vector<std::uint8_t>* mask) const;
+};
+
+/// What a keyframe changed. Where `corrected`, every keyframe has a new pose: keyframe i's
+/// object frame moved by `corrections[i]` (new cam_from_object = old · correction).
+struct KeyframeUpdate {
+  bool added = false;
+  int loops = 0;
+  bool corrected = false;
+  /// The largest move of a keyframe (mm at the lever).
+  double correction_mm = 0;
+  std::vector<Rigid3> corrections;
+};
+
+/// The keyframes and the pose graph over them. Not thread-safe; ObjectFusion owns it.
+class KeyframeGraph {
+ public:
+  KeyframeGraph(const CameraIntrinsics& intrinsics, LoopClosureOptions options = {},
+                IcpOptions icp = {});
+
+  /// Considers a fused frame: the object's pixels under `mask` inside `box` (u0, v0, u1, v1),
+  /// fused at `cam_from_object`, the `stamp`-th fused frame.
+  KeyframeUpdate Observe(const Frame& frame, const std::vector<std::uint8_t>& mask,
+                         const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp);
+
+  const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  int loops() const { return loops_; }
+  int corrections() const { return corrections_; }
+  /// How the object frame of a frame with `stamp` moved in the last correction: the
+  /// correction of the keyframes around it, interpolated by stamp.
+  static Rigid3 CorrectionAt(const std::vector<Keyframe>& keyframes,
+                             const std::vector<Rigid3>& corrections, int stamp);
+
+  /// The motion from keyframe `from`'s camera to keyframe `to`'s that registers the first's
+  /// points on the second's surface, starting from their poses; none where that is not a
+  /// loop (see LoopClosureOptions).
+  std::optional<Rigid3> Register(const Keyframe& from, const Keyframe& to);
+
+ private:
+  // The keyframe of a fused frame.
+  Keyframe Keep(const Frame& frame, const std::vector<std::uint8_t>& mask,
+                const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp) const;
+  // ICP of `from`'s points on scratch_ (the target drawn) from `start`, coarse to fine: the
+  // motion where it is a loop (and its pairs in `inliers`).
+  std::optional<Rigid3> Align(const Keyframe& from, const Rigid3& start, int* inliers) const;
+  // The earlier keyframes the newest one is tried against, nearest turn first.
+  std::vector<int> LoopCandidates() const;
+  // `keyframe`'s surface as ICP's model image (scratch_), normals from its depth.
+  void DrawTarget(const Keyframe& keyframe);
+  // Solves the graph; where it moves a keyframe by more than refuse_min_mm, takes the new
+  // poses and says so in `update`.
+  void Solve(KeyframeUpdate* update);
+
+  const CameraIntrinsics intrinsics_;
+  const LoopClosureOptions options_;
+  IcpOptions icp_;
+  std::vector<Keyframe> keyframes_;
+  std::vector<PoseGraphEdge> edges_;
+  // A loop waiting for another to agree with it: its edge, where it puts its keyframe's
+  // object (cam_from_object) and whether one did.
+  struct Loop {
+    PoseGraphEdge edge;
+    Rigid3 placed;
+    bool confirmed = false;
+  };
+  std::vector<Loop> pending_;
+  RaycastImage scratch_;
+  int loops_ = 0;
+  int corrections_ = 0;
+};
+
+}  // namespace ihs::fusion

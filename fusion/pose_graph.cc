@@ -1,0 +1,126 @@
+#include "fusion/pose_graph.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+
+#include "core/check.h"
+
+namespace ihs::fusion {
+namespace {
+
+// A node's parameters: object_from_cam as an angle-axis turn and a translation.
+using NodeParameters = std::array<double, 6>;
+
+NodeParameters ToParameters(const Rigid3& cam_from_object) {
+  const Rigid3 object_from_cam = cam_from_object.Inverse();
+  const Eigen::AngleAxisd turn(object_from_cam.rotation());
+  const Eigen::Vector3d axis_angle = turn.angle() * turn.axis();
+  const Eigen::Vector3d t = object_from_cam.translation();
+  return {axis_angle.x(), axis_angle.y(), axis_angle.z(), t.x(), t.y(), t.z()};
+}
+
+Rigid3 FromParameters(const NodeParameters& p) {
+  return Rigid3::FromRotationVector({p[0], p[1], p[2]}, {p[3], p[4], p[5]}).Inverse();
+}
+
+// The edge's disagreement: object_from_cam_to · to_from_from · cam_from_from_object should be
+// the identity; the residual is how far it moves four points of the object frame.
+class EdgeCost {
+ public:
+  EdgeCost(const Rigid3& to_from_from, double lever_mm, double weight)
+      : lever_(lever_mm), weight_(weight) {
+    const Eigen::AngleAxisd turn(to_from_from.rotation());
+    const Eigen::Vector3d axis_angle = turn.angle() * turn.axis();
+    for (int i = 0; i < 3; ++i) {
+      turn_[i] = axis_angle[i];
+      shift_[i] = to_from_from.translation()[i];
+    }
+  }
+
+  template <typename T>
+  bool operator()(const T* from, const T* to, T* residuals) const {
+    const T back[3] = {-from[0], -from[1], -from[2]};
+    const T measured[3] = {T(turn_[0]), T(turn_[1]), T(turn_[2])};
+    for (int n = 0; n < 4; ++n) {
+      T p[3] = {T(0), T(0), T(0)};
+      if (n > 0) p[n - 1] = T(lever_);
+      // p (object) → camera `from` → camera `to` → object.
+      const T local[3] = {p[0] - from[3], p[1] - from[4], p[2] - from[5]};
+      T in_from[3], in_to[3], back_in_object[3];
+      ceres::AngleAxisRotatePoint(back, local, in_from);
+      ceres::AngleAxisRotatePoint(measured, in_from, in_to);
+      for (int i = 0; i < 3; ++i) in_to[i] += T(shift_[i]);
+      ceres::AngleAxisRotatePoint(to, in_to, back_in_object);
+      for (int i = 0; i < 3; ++i)
+        residuals[3 * n + i] = T(weight_) * (back_in_object[i] + to[3 + i] - p[i]);
+    }
+    return true;
+  }
+
+ private:
+  double lever_;
+  double weight_;
+  double turn_[3];
+  double shift_[3];
+};
+
+}  // namespace
+
+void PoseGraphOptions::Check() const {
+  IHS_CHECK_ARG(lever_mm > 0, "pose graph lever_mm must be positive");
+  IHS_CHECK_ARG(robust_scale_mm > 0, "pose graph robust_scale_mm must be positive");
+  IHS_CHECK_ARG(max_iterations >= 1, "pose graph max_iterations must be >= 1");
+}
+
+std::vector<Rigid3> SolvePoseGraph(const std::vector<Rigid3>& cam_from_object,
+                                   const std::vector<PoseGraphEdge>& edges,
+                                   const PoseGraphOptions& options) {
+  options.Check();
+  const int nodes = static_cast<int>(cam_from_object.size());
+  std::vector<NodeParameters> parameters;
+  for (const Rigid3& pose : cam_from_object) parameters.push_back(ToParameters(pose));
+  ceres::Problem problem;
+  for (const PoseGraphEdge& edge : edges) {
+    IHS_CHECK_ARG(
+        edge.from >= 0 && edge.from < nodes && edge.to >= 0 && edge.to < nodes &&
+            edge.from != edge.to,
+        "pose graph edge " << edge.from << " -> " << edge.to << " of " << nodes << " nodes");
+    auto* cost = new ceres::AutoDiffCostFunction<EdgeCost, 12, 6, 6>(
+        new EdgeCost(edge.to_from_from, options.lever_mm, edge.weight));
+    ceres::LossFunction* loss =
+        edge.robust ? new ceres::CauchyLoss(options.robust_scale_mm) : nullptr;
+    problem.AddResidualBlock(cost, loss, parameters[edge.from].data(), parameters[edge.to].data());
+  }
+  if (problem.NumResidualBlocks() == 0 || !problem.HasParameterBlock(parameters[0].data())) {
+    return cam_from_object;
+  }
+  problem.SetParameterBlockConstant(parameters[0].data());
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  std::vector<Rigid3> solved;
+  for (const NodeParameters& p : parameters) solved.push_back(FromParameters(p));
+  return solved;
+}
+
+double PoseDistanceMm(const Rigid3& a, const Rigid3& b, double lever_mm) {
+  // Both poses seen from the object: how far apart they put the same points.
+  const Rigid3 difference = b.Inverse() * a;
+  double largest = 0;
+  for (int n = 0; n < 4; ++n) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    if (n > 0) p[n - 1] = lever_mm;
+    largest = std::max(largest, (difference * p - p).norm());
+  }
+  return largest;
+}
+
+}  // namespace ihs::fusion

@@ -1,0 +1,50 @@
+#pragma once
+// A pose graph over views of one rigid object: each node is a view's pose (cam_from_object),
+// each edge a measured motion between two views' cameras (cam_to_from_cam_from). Solving it
+// spreads what the edges disagree on — a full turn's accumulated drift, once an edge ties its
+// end to its start — over the views, the way the edges allow (Lu & Milios 1997; Ceres' pose
+// graph example solves the same problem on 2-D and 3-D maps).
+
+#include <vector>
+
+#include "core/rigid3.h"
+
+namespace ihs::fusion {
+
+/// One measured motion: the camera of view `to` from the camera of view `from`.
+struct PoseGraphEdge {
+  int from = 0;
+  int to = 0;
+  Rigid3 to_from_from;
+  /// Relative weight of its residual.
+  double weight = 1.0;
+  /// Whether a large disagreement is down-weighted (Cauchy): for edges of which one may be
+  /// wrong by much (a frame-to-frame registration that slid), not for checked ones.
+  bool robust = false;
+};
+
+/// Options of the solve (defaults: a hand-held object a few centimetres across).
+struct PoseGraphOptions {
+  /// An edge's disagreement is measured as how far it moves the object frame's origin and three
+  /// points this far from it along its axes (mm): turns and shifts weigh as they move the
+  /// object's surface.
+  double lever_mm = 40.0;
+  /// Scale of the robust edges' Cauchy loss, mm of disagreement.
+  double robust_scale_mm = 2.0;
+  int max_iterations = 50;
+
+  /// Throws std::invalid_argument naming the bad field.
+  void Check() const;
+};
+
+/// The poses (cam_from_object, one per node) that best agree with `edges`, node 0 held where it
+/// is (it fixes the object frame). Nodes no edge reaches keep their pose.
+std::vector<Rigid3> SolvePoseGraph(const std::vector<Rigid3>& cam_from_object,
+                                   const std::vector<PoseGraphEdge>& edges,
+                                   const PoseGraphOptions& options = {});
+
+/// How far `a` and `b` (two poses of the object, cam_from_object) put the object's points at
+/// `lever_mm` from its origin apart, at most (mm).
+double PoseDistanceMm(const Rigid3& a, const Rigid3& b, double lever_mm);
+
+}  // namespace ihs::fusion

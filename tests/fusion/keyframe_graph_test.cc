@@ -1,0 +1,151 @@
+#include "fusion/keyframe_graph.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "fusion/pose_graph.h"
+#include "tests/frame_fixtures.h"
+
+namespace ihs::fusion {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kLever = 40.0;
+
+// The object turned by `turn_deg` about its y axis, tilted towards the camera, 450 mm away.
+Rigid3 TruePose(double turn_deg) {
+  return Rigid3::Translation({0, 0, 450}) * Rigid3::FromAxisAngle({1, 0, 0}, 25 * kDeg) *
+         Rigid3::FromAxisAngle({0, 1, 0}, turn_deg * kDeg);
+}
+
+// Drift of `steps` tracked frames: each turns the object frame by 0.06° and shifts it 0.12 mm.
+Rigid3 Drift(int steps) {
+  return Rigid3::Translation({0.12 * steps, 0, 0.05 * steps}) *
+         Rigid3::FromAxisAngle({0, 1, 0}, 0.06 * steps * kDeg);
+}
+
+TEST(PoseGraphTest, ALoopSpreadsTheChainsDriftAndHoldsTheFirstPose) {
+  // A chain of 36 poses a full turn round, each step measured with drift, and one edge that
+  // ties the last to the first as they truly are.
+  std::vector<Rigid3> truth, tracked;
+  for (int i = 0; i < 36; ++i) {
+    truth.push_back(TruePose(10.0 * i));
+    tracked.push_back(TruePose(10.0 * i) * Drift(4 * i));
+  }
+  std::vector<PoseGraphEdge> edges;
+  for (int i = 1; i < 36; ++i)
+    edges.push_back({i - 1, i, tracked[i] * tracked[i - 1].Inverse(), 1.0, true});
+  edges.push_back({35, 0, truth[0] * truth[35].Inverse(), 1.0, false});
+  ASSERT_GT(PoseDistanceMm(tracked[35], truth[35], kLever), 15.0);
+
+  const std::vector<Rigid3> solved = SolvePoseGraph(tracked, edges);
+  ASSERT_EQ(solved.size(), tracked.size());
+  EXPECT_LT(PoseDistanceMm(solved[0], truth[0], kLever), 1e-6);
+  EXPECT_LT(PoseDistanceMm(solved[35], truth[35], kLever), 1.0);
+  // Half-way round, half the drift is taken away at least.
+  EXPECT_LT(PoseDistanceMm(solved[18], truth[18], kLever),
+            0.6 * PoseDistanceMm(tracked[18], truth[18], kLever));
+}
+
+TEST(PoseGraphTest, WithoutEdgesThePosesStay) {
+  const std::vector<Rigid3> poses = {TruePose(0), TruePose(20)};
+  const std::vector<Rigid3> solved = SolvePoseGraph(poses, {});
+  EXPECT_LT(PoseDistanceMm(solved[1], poses[1], kLever), 1e-9);
+  EXPECT_THROW(SolvePoseGraph(poses, {{0, 2, Rigid3(), 1.0, false}}), std::invalid_argument);
+}
+
+struct TurnResult {
+  int loops = 0;
+  int corrections = 0;
+  // The last frame's pose, corrected as ObjectFusion carries on from a correction, and the
+  // keyframes' largest error at the end (mm at the lever), against the truth.
+  double end_error_mm = 0;
+  double worst_keyframe_mm = 0;
+  double drifted_end_mm = 0;
+};
+
+// A full turn and a bit of an object rendered exactly, tracked with drift, through a graph.
+TurnResult TurnWithDrift(const Eigen::Vector3d& semi_axes_mm) {
+  const CameraIntrinsics intrinsics;
+  KeyframeGraph graph(intrinsics);
+  TurnResult out;
+  Rigid3 applied;  // What the corrections so far moved the object frame by.
+  Rigid3 last;
+  const int frames = 125;  // 3° a frame: 372°.
+  for (int i = 0; i < frames; ++i) {
+    const Rigid3 truth = TruePose(3.0 * i);
+    const Frame frame = test::RenderEllipsoid(intrinsics, truth, semi_axes_mm);
+    std::vector<std::uint8_t> mask(frame.depth_mm.size(), 0);
+    std::array<int, 4> box = {frame.width, frame.height, 0, 0};
+    for (int v = 0; v < frame.height; ++v) {
+      for (int u = 0; u < frame.width; ++u) {
+        if (frame.DepthAt(u, v) == 0) continue;
+        mask[v * frame.width + u] = 1;
+        box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u + 1),
+               std::max(box[3], v + 1)};
+      }
+    }
+    const Rigid3 tracked = truth * Drift(i) * applied;
+    const KeyframeUpdate update = graph.Observe(frame, mask, box, tracked, i);
+    last = tracked;
+    out.loops += update.loops;
+    if (update.corrected) {
+      ++out.corrections;
+      applied = applied * update.corrections.back();
+      last = tracked * update.corrections.back();
+    }
+  }
+  out.drifted_end_mm = PoseDistanceMm(TruePose(3.0 * (frames - 1)) * Drift(frames - 1),
+                                      TruePose(3.0 * (frames - 1)), kLever);
+  out.end_error_mm = PoseDistanceMm(last, TruePose(3.0 * (frames - 1)), kLever);
+  for (const Keyframe& keyframe : graph.keyframes()) {
+    out.worst_keyframe_mm =
+        std::max(out.worst_keyframe_mm,
+                 PoseDistanceMm(keyframe.cam_from_object, TruePose(3.0 * keyframe.stamp), kLever));
+  }
+  return out;
+}
+
+TEST(KeyframeGraphTest, AFullTurnOfAnUnevenObjectIsClosedAndItsDriftCorrected) {
+  const TurnResult turn = TurnWithDrift({45, 30, 20});
+  std::printf("drift at the end %.1f mm, corrected %.2f mm; worst keyframe %.2f mm; %d loops\n",
+              turn.drifted_end_mm, turn.end_error_mm, turn.worst_keyframe_mm, turn.loops);
+  EXPECT_GT(turn.loops, 0);
+  EXPECT_GE(turn.corrections, 1);
+  EXPECT_GT(turn.drifted_end_mm, 15.0);
+  EXPECT_LT(turn.end_error_mm, 2.0);
+  // The drift is spread over the turn: no keyframe is left as far off as the end was.
+  EXPECT_LT(turn.worst_keyframe_mm, 0.5 * turn.drifted_end_mm);
+}
+
+TEST(KeyframeGraphTest, ABallClosesNoLoopItsTurnIsNotSeenInItsShape) {
+  const TurnResult turn = TurnWithDrift({35, 35, 35});
+  EXPECT_EQ(turn.loops, 0);
+  EXPECT_EQ(turn.corrections, 0);
+}
+
+TEST(KeyframeGraphTest, CorrectionsAreInterpolatedBetweenKeyframes) {
+  std::vector<Keyframe> keyframes(2);
+  keyframes[0].stamp = 10;
+  keyframes[1].stamp = 20;
+  const std::vector<Rigid3> corrections = {Rigid3(), Rigid3::Translation({10, 0, 0})};
+  EXPECT_NEAR(KeyframeGraph::CorrectionAt(keyframes, corrections, 0).translation().x(), 0, 1e-9);
+  EXPECT_NEAR(KeyframeGraph::CorrectionAt(keyframes, corrections, 15).translation().x(), 5, 1e-9);
+  EXPECT_NEAR(KeyframeGraph::CorrectionAt(keyframes, corrections, 30).translation().x(), 10, 1e-9);
+}
+
+TEST(LoopClosureOptionsTest, BadValuesAreNamed) {
+  LoopClosureOptions options;
+  options.keyframe_turn_deg = 0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options = {};
+  options.loop_max_turn_deg = 95;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ihs::fusion
