@@ -214,11 +214,12 @@ void AddLoopClosureOptions(OptionRegistry& r, fusion::LoopClosureOptions* option
         "... and moves the chain's estimate by less than this, mm");
   r.Add("fusion.loop_closure.refuse_min_mm", &l.refuse_min_mm,
         "the model is re-fused when the solved graph moves a keyframe farther than this, mm");
+  r.Add("fusion.loop_closure.chain_trusted_kept", &l.chain_trusted_kept,
+        "the tracked motion between keyframes weighs less in the pose graph where a frame's "
+        "ICP kept fewer than this share of its first pairs");
   r.Add("fusion.loop_closure.lever_mm", &l.graph.lever_mm,
         "the pose graph weighs turns by how far they move points this far from the object's "
         "origin, mm");
-  r.Add("fusion.loop_closure.robust_scale_mm", &l.graph.robust_scale_mm,
-        "scale of the chain edges' Cauchy loss, mm");
 }
 
 }  // namespace

@@ -34,6 +34,8 @@ void LoopClosureOptions::Check() const {
   IHS_CHECK_ARG(loop_pending_keyframes >= 1,
                 "fusion.loop_closure.loop_pending_keyframes must be >= 1");
   IHS_CHECK_ARG(loop_agreement_mm > 0, "fusion.loop_closure.loop_agreement_mm must be positive");
+  IHS_CHECK_ARG(chain_trusted_kept > 0.5 && chain_trusted_kept <= 1,
+                "fusion.loop_closure.chain_trusted_kept must be in (0.5, 1]");
   IHS_CHECK_ARG(icp_start_mm > 0, "fusion.loop_closure.icp_start_mm must be positive");
   IHS_CHECK_ARG(min_inlier_fraction > 0 && min_inlier_fraction <= 1,
                 "fusion.loop_closure.min_inlier_fraction must be in (0, 1]");
@@ -92,8 +94,9 @@ Rigid3 KeyframeGraph::CorrectionAt(const std::vector<Keyframe>& keyframes,
 
 KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std::uint8_t>& mask,
                                       const std::array<int, 4>& box, const Rigid3& cam_from_object,
-                                      int stamp) {
+                                      int stamp, double kept_pairs) {
   KeyframeUpdate update;
+  chain_kept_ = std::min(chain_kept_, kept_pairs);
   if (!options_.enabled || static_cast<int>(keyframes_.size()) >= options_.max_keyframes ||
       box[2] <= box[0] || box[3] <= box[1]) {
     return update;
@@ -104,21 +107,38 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
   }
   keyframes_.push_back(Keep(frame, mask, box, cam_from_object, stamp));
   update.added = true;
+  if (keyframes_.size() == 1) return update;
+  AddChainEdge();
+  update.loops = AddConfirmedLoops();
+  loops_ += update.loops;
+  if (update.loops > 0) Solve(&update);
+  return update;
+}
+
+void KeyframeGraph::AddChainEdge() {
+  // The tracked motion from the previous keyframe, trusted less where a frame in between
+  // may have slid.
   const int newest = static_cast<int>(keyframes_.size()) - 1;
-  if (newest == 0) return update;
-  // The tracked motion from the previous keyframe: robust, a frame in between may have slid.
-  edges_.push_back({newest - 1, newest,
-                    cam_from_object * keyframes_[newest - 1].cam_from_object.Inverse(), 1.0, true});
+  const double trust =
+      std::clamp((chain_kept_ - 0.5) / (options_.chain_trusted_kept - 0.5), 0.1, 1.0);
+  chain_kept_ = 1.0;
+  edges_.push_back(
+      {newest - 1, newest,
+       keyframes_[newest].cam_from_object * keyframes_[newest - 1].cam_from_object.Inverse(),
+       std::pow(trust, 4)});
+}
+
+int KeyframeGraph::AddConfirmedLoops() {
   // Loops with the earlier keyframes. One counts only where another agrees with it — of this
   // keyframe or of one of the last `loop_pending_keyframes`, carried along the chain — on
   // where this keyframe's object is, within `loop_agreement_mm`: a view that registers where
   // it is not (a cube's faces are alike) rarely does so twice alike.
+  const int newest = static_cast<int>(keyframes_.size()) - 1;
   std::vector<Loop> found;
   for (int earlier : LoopCandidates()) {
     if (std::optional<Rigid3> motion = Register(keyframes_[newest], keyframes_[earlier])) {
-      found.push_back({{newest, earlier, *motion, 1.0, false},
-                       motion->Inverse() * keyframes_[earlier].cam_from_object,
-                       false});
+      found.push_back({{newest, earlier, *motion, 1.0},
+                       motion->Inverse() * keyframes_[earlier].cam_from_object});
     }
   }
   std::vector<Loop*> all;
@@ -128,7 +148,7 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
   std::vector<Rigid3> placed;
   for (const Loop* loop : all) {
     const Rigid3& then = keyframes_[loop->edge.from].cam_from_object;
-    placed.push_back(cam_from_object * then.Inverse() * loop->placed);
+    placed.push_back(keyframes_[newest].cam_from_object * then.Inverse() * loop->placed);
   }
   for (size_t i = 0; i < all.size(); ++i) {
     for (size_t j = i + 1; j < all.size(); ++j) {
@@ -139,19 +159,18 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
       }
     }
   }
+  int added = 0;
   std::vector<Loop> still_pending;
-  for (Loop* loop : all) {
+  for (const Loop* loop : all) {
     if (loop->confirmed) {
       edges_.push_back(loop->edge);
-      ++update.loops;
-      ++loops_;
+      ++added;
     } else if (newest - loop->edge.from < options_.loop_pending_keyframes) {
       still_pending.push_back(*loop);
     }
   }
   pending_ = std::move(still_pending);
-  if (update.loops > 0) Solve(&update);
-  return update;
+  return added;
 }
 
 Keyframe KeyframeGraph::Keep(const Frame& frame, const std::vector<std::uint8_t>& mask,
@@ -308,6 +327,8 @@ void KeyframeGraph::Solve(KeyframeUpdate* update) {
   if (update->correction_mm < options_.refuse_min_mm) return;
   update->corrected = true;
   ++corrections_;
+  // Loops waiting for a second were placed against the poses that now moved.
+  pending_.clear();
   for (size_t i = 0; i < poses.size(); ++i) {
     update->corrections.push_back(poses[i].Inverse() * solved[i]);
     keyframes_[i].cam_from_object = solved[i];

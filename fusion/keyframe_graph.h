@@ -62,8 +62,13 @@ struct LoopClosureOptions {
   /// The model is re-fused only when the solved graph moves some keyframe by more than this
   /// (mm at the lever): less is the keyframe registration's own noise.
   double refuse_min_mm = 1.5;
-  /// The chain's edges (the tracked motion between consecutive keyframes) are robust (one
-  /// frame that slid may carry the whole disagreement); the loops are not.
+  /// The chain's edges (the tracked motion between consecutive keyframes) weigh by the least
+  /// share of its first pairs that a frame's ICP between the two keyframes kept at its end
+  /// (IcpResult): ((share − 0.5) / (chain_trusted_kept − 0.5))^4, clamped to [1e-4, 1]. A
+  /// slide starts where that share drops (0.6–0.75 where a box slid 20 mm, 0.95–1 in most
+  /// frames): a loop's correction then goes where the chain broke rather than spread over
+  /// the turn, and evenly where nothing broke (a slow drift).
+  double chain_trusted_kept = 0.95;
   PoseGraphOptions graph;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -107,9 +112,11 @@ class KeyframeGraph {
                 IcpOptions icp = {});
 
   /// Considers a fused frame: the object's pixels under `mask` inside `box` (u0, v0, u1, v1),
-  /// fused at `cam_from_object`, the `stamp`-th fused frame.
+  /// fused at `cam_from_object`, the `stamp`-th fused frame, whose ICP kept `kept_pairs` of the
+  /// pairs it started with (1 where it did not run).
   KeyframeUpdate Observe(const Frame& frame, const std::vector<std::uint8_t>& mask,
-                         const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp);
+                         const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp,
+                         double kept_pairs = 1.0);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   int loops() const { return loops_; }
@@ -131,6 +138,11 @@ class KeyframeGraph {
   // ICP of `from`'s points on scratch_ (the target drawn) from `start`, coarse to fine: the
   // motion where it is a loop (and its pairs in `inliers`).
   std::optional<Rigid3> Align(const Keyframe& from, const Rigid3& start, int* inliers) const;
+  // The newest keyframe's edge to the one before: the tracked motion, weighed by chain_kept_.
+  void AddChainEdge();
+  // Registers the newest keyframe against earlier ones, adds the loops that a second one
+  // confirms (its own or pending ones) to the graph and returns how many.
+  int AddConfirmedLoops();
   // The earlier keyframes the newest one is tried against, nearest turn first.
   std::vector<int> LoopCandidates() const;
   // `keyframe`'s surface as ICP's model image (scratch_), normals from its depth.
@@ -152,6 +164,8 @@ class KeyframeGraph {
     bool confirmed = false;
   };
   std::vector<Loop> pending_;
+  // The least share of its first pairs a frame's ICP kept since the last keyframe.
+  double chain_kept_ = 1.0;
   RaycastImage scratch_;
   int loops_ = 0;
   int corrections_ = 0;

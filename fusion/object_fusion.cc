@@ -246,8 +246,12 @@ void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& objec
 }
 
 void ObjectFusion::CloseLoops(const ObjectPixels& object, FusionResult* result) {
-  const KeyframeUpdate update =
-      keyframes_.Observe(object.frame, object.mask, object.box, cam_from_object_, fused_frames_);
+  const double kept_pairs =
+      result->icp.first_inliers > 0
+          ? static_cast<double>(result->icp.inliers) / result->icp.first_inliers
+          : 1.0;
+  const KeyframeUpdate update = keyframes_.Observe(object.frame, object.mask, object.box,
+                                                   cam_from_object_, fused_frames_, kept_pairs);
   result->keyframe = update.added;
   result->loops = update.loops;
   if (update.corrected) ApplyCorrection(update, result);

@@ -72,7 +72,6 @@ class EdgeCost {
 
 void PoseGraphOptions::Check() const {
   IHS_CHECK_ARG(lever_mm > 0, "pose graph lever_mm must be positive");
-  IHS_CHECK_ARG(robust_scale_mm > 0, "pose graph robust_scale_mm must be positive");
   IHS_CHECK_ARG(max_iterations >= 1, "pose graph max_iterations must be >= 1");
 }
 
@@ -91,9 +90,8 @@ std::vector<Rigid3> SolvePoseGraph(const std::vector<Rigid3>& cam_from_object,
         "pose graph edge " << edge.from << " -> " << edge.to << " of " << nodes << " nodes");
     auto* cost = new ceres::AutoDiffCostFunction<EdgeCost, 12, 6, 6>(
         new EdgeCost(edge.to_from_from, options.lever_mm, edge.weight));
-    ceres::LossFunction* loss =
-        edge.robust ? new ceres::CauchyLoss(options.robust_scale_mm) : nullptr;
-    problem.AddResidualBlock(cost, loss, parameters[edge.from].data(), parameters[edge.to].data());
+    problem.AddResidualBlock(cost, nullptr, parameters[edge.from].data(),
+                             parameters[edge.to].data());
   }
   if (problem.NumResidualBlocks() == 0 || !problem.HasParameterBlock(parameters[0].data())) {
     return cam_from_object;

@@ -16,11 +16,9 @@ struct PoseGraphEdge {
   int from = 0;
   int to = 0;
   Rigid3 to_from_from;
-  /// Relative weight of its residual.
+  /// Relative weight of its residual (least squares: where edges disagree, an edge of weight
+  /// w takes 1/w² as much of the disagreement as one of weight 1).
   double weight = 1.0;
-  /// Whether a large disagreement is down-weighted (Cauchy): for edges of which one may be
-  /// wrong by much (a frame-to-frame registration that slid), not for checked ones.
-  bool robust = false;
 };
 
 /// Options of the solve (defaults: a hand-held object a few centimetres across).
@@ -29,8 +27,6 @@ struct PoseGraphOptions {
   /// points this far from it along its axes (mm): turns and shifts weigh as they move the
   /// object's surface.
   double lever_mm = 40.0;
-  /// Scale of the robust edges' Cauchy loss, mm of disagreement.
-  double robust_scale_mm = 2.0;
   int max_iterations = 50;
 
   /// Throws std::invalid_argument naming the bad field.

@@ -38,8 +38,8 @@ TEST(PoseGraphTest, ALoopSpreadsTheChainsDriftAndHoldsTheFirstPose) {
   }
   std::vector<PoseGraphEdge> edges;
   for (int i = 1; i < 36; ++i)
-    edges.push_back({i - 1, i, tracked[i] * tracked[i - 1].Inverse(), 1.0, true});
-  edges.push_back({35, 0, truth[0] * truth[35].Inverse(), 1.0, false});
+    edges.push_back({i - 1, i, tracked[i] * tracked[i - 1].Inverse(), 1.0});
+  edges.push_back({35, 0, truth[0] * truth[35].Inverse(), 1.0});
   ASSERT_GT(PoseDistanceMm(tracked[35], truth[35], kLever), 15.0);
 
   const std::vector<Rigid3> solved = SolvePoseGraph(tracked, edges);
@@ -55,7 +55,7 @@ TEST(PoseGraphTest, WithoutEdgesThePosesStay) {
   const std::vector<Rigid3> poses = {TruePose(0), TruePose(20)};
   const std::vector<Rigid3> solved = SolvePoseGraph(poses, {});
   EXPECT_LT(PoseDistanceMm(solved[1], poses[1], kLever), 1e-9);
-  EXPECT_THROW(SolvePoseGraph(poses, {{0, 2, Rigid3(), 1.0, false}}), std::invalid_argument);
+  EXPECT_THROW(SolvePoseGraph(poses, {{0, 2, Rigid3(), 1.0}}), std::invalid_argument);
 }
 
 struct TurnResult {
