@@ -71,6 +71,35 @@ TEST(FreeSpaceTest, SpaceInFrontOfTheSurfaceIsEmptyOnceTwoViewsSawThroughIt) {
   EXPECT_NEAR(two.Emptiness(past, 3), 2.0, 0.6);  // Depth rounded to whole mm.
 }
 
+TEST(FreeSpaceTest, ReposedViewsSeeTheSpaceWhereTheCorrectionMovedIt) {
+  // Two views kept with the object frame 30 mm off along x (as a drift would leave them),
+  // then corrected: the cube's inside is where it is again, not 30 mm aside.
+  const Rigid3 off = Rigid3::Translation({30, 0, 0});
+  FreeSpaceOptions options;
+  options.min_turn_deg = 0;
+  FreeSpace free_space(kCamera, options);
+  int stamp = 0;
+  for (const Rigid3& pose : {Turned(0), Turned(5)}) {
+    const test::RenderedView view = CubeView(kCamera, pose);
+    free_space.Observe(view.frame, view.object_box, pose * off, nullptr, stamp++);
+  }
+  // The cube's centre; the point the off views took for it.
+  const Eigen::Vector3f centre(0, 0, 0);
+  const Eigen::Vector3f taken(-30, 0, 0);
+  EXPECT_GT(free_space.Emptiness(centre, 3), 0);
+  EXPECT_LT(free_space.Emptiness(taken, 3), 0);
+  const FreeSpace before = free_space;  // Copies share views: Repose must not change them.
+  std::vector<int> stamps;
+  free_space.Repose([&](int view_stamp) {
+    stamps.push_back(view_stamp);
+    return off.Inverse();
+  });
+  EXPECT_EQ(stamps, (std::vector<int>{0, 1}));
+  EXPECT_LT(free_space.Emptiness(centre, 3), 0);
+  EXPECT_GT(free_space.Emptiness(taken, 3), 0);
+  EXPECT_GT(before.Emptiness(centre, 3), 0);
+}
+
 TEST(FreeSpaceTest, PixelsWithoutDepthFarFromAnyWithDepthAreRaysThatMetNothing) {
   const Eigen::Vector3f beside(kCubeEdgeMm / 2 + 15, 0, 0);
   EXPECT_GT(Views({Turned(0), Turned(5)}).Emptiness(beside, 3), 0);

@@ -167,5 +167,25 @@ TEST(TsdfVolumeTest, MaskedPixelsAloneAreIntegratedAndBadInputIsRefused) {
   EXPECT_THROW(TsdfVolume{bad}, std::invalid_argument);
 }
 
+TEST(TsdfVolumeTest, ClearForgetsEveryObservationAndTheVolumeFusesAnew) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  const Rigid3 view = Rigid3::Translation({0, 0, 600});
+  const Frame frame = RenderSphere(intrinsics, view);
+  TsdfVolume volume;
+  const std::vector<std::uint8_t> all;
+  volume.Integrate(frame, all, intrinsics, view);
+  const std::int64_t observed = volume.ObservedVoxels();
+  const size_t faces = volume.ExtractMesh().faces.size();
+  ASSERT_GT(observed, 0);
+  volume.Clear();
+  EXPECT_EQ(volume.ObservedVoxels(), 0);
+  EXPECT_TRUE(volume.ObservedBox().isEmpty());
+  EXPECT_TRUE(volume.ExtractMesh().Empty());
+  // Fused again, it is as it was.
+  volume.Integrate(frame, all, intrinsics, view);
+  EXPECT_EQ(volume.ObservedVoxels(), observed);
+  EXPECT_EQ(volume.ExtractMesh().faces.size(), faces);
+}
+
 }  // namespace
 }  // namespace ihs::fusion
