@@ -11,10 +11,7 @@ namespace ihs::fusion {
 namespace {
 
 // The angle between two poses' views of the object, degrees.
-double TurnDeg(const Rigid3& a, const Rigid3& b) {
-  const double trace = (a.rotation() * b.rotation().transpose()).trace();
-  return std::acos(std::clamp(0.5 * (trace - 1.0), -1.0, 1.0)) * 180.0 / M_PI;
-}
+double TurnDeg(const Rigid3& a, const Rigid3& b) { return a.RotationAngleToRad(b) * 180.0 / M_PI; }
 
 Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3f>& points) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();

@@ -17,8 +17,7 @@ using NodeParameters = std::array<double, 6>;
 
 NodeParameters ToParameters(const Rigid3& cam_from_object) {
   const Rigid3 object_from_cam = cam_from_object.Inverse();
-  const Eigen::AngleAxisd turn(object_from_cam.rotation());
-  const Eigen::Vector3d axis_angle = turn.angle() * turn.axis();
+  const Eigen::Vector3d axis_angle = object_from_cam.RotationVector();
   const Eigen::Vector3d t = object_from_cam.translation();
   return {axis_angle.x(), axis_angle.y(), axis_angle.z(), t.x(), t.y(), t.z()};
 }
@@ -33,8 +32,7 @@ class EdgeCost {
  public:
   EdgeCost(const Rigid3& to_from_from, double lever_mm, double weight)
       : lever_(lever_mm), weight_(weight) {
-    const Eigen::AngleAxisd turn(to_from_from.rotation());
-    const Eigen::Vector3d axis_angle = turn.angle() * turn.axis();
+    const Eigen::Vector3d axis_angle = to_from_from.RotationVector();
     for (int i = 0; i < 3; ++i) {
       turn_[i] = axis_angle[i];
       shift_[i] = to_from_from.translation()[i];
