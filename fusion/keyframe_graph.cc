@@ -107,7 +107,6 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
   if (keyframes_.size() == 1) return update;
   AddChainEdge();
   update.loops = AddConfirmedLoops();
-  loops_ += update.loops;
   if (update.loops > 0) Solve(&update);
   return update;
 }
@@ -323,7 +322,6 @@ void KeyframeGraph::Solve(KeyframeUpdate* update) {
   }
   if (update->correction_mm < options_.refuse_min_mm) return;
   update->corrected = true;
-  ++corrections_;
   // Loops waiting for a second were placed against the poses that now moved.
   pending_.clear();
   for (size_t i = 0; i < poses.size(); ++i) {

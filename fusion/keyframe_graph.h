@@ -119,8 +119,6 @@ class KeyframeGraph {
                          double kept_pairs = 1.0);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
-  int loops() const { return loops_; }
-  int corrections() const { return corrections_; }
   /// How the object frame of a frame with `stamp` moved in the last correction: the
   /// correction of the keyframes around it, interpolated by stamp.
   static Rigid3 CorrectionAt(const std::vector<Keyframe>& keyframes,
@@ -167,8 +165,6 @@ class KeyframeGraph {
   // The least share of its first pairs a frame's ICP kept since the last keyframe.
   double chain_kept_ = 1.0;
   RaycastImage scratch_;
-  int loops_ = 0;
-  int corrections_ = 0;
 };
 
 }  // namespace ihs::fusion
