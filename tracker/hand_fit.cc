@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "core/levenberg_marquardt.h"
 #include "core/point_kd_tree.h"
 #include "core/rigid_fit.h"
 #include "tracker/hand_fit_cost.h"
@@ -591,22 +592,25 @@ std::vector<SilhouettePair> HandFitter::FitState::SilhouettePairs() const {
 // Solves the inner problem with `terms` from the current pose, which it then replaces.
 void HandFitter::FitState::Solve(HandFitTerms terms) {
   PoseParameters parameters(pose_);
-  ceres::Problem problem;
-  problem.AddResidualBlock(new HandFitCost(model_, parameters.reference_rotation(), intrinsics_,
-                                           std::move(terms), options_.collision_weight,
-                                           options_.limit_weight, options_.prior_weight, prior_),
-                           nullptr, parameters.values().data());
-  ceres::Solver::Options solver;
-  // A few hundred residual rows, ≈ 30 parameters: the normal equations are small and cheap.
-  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  solver.max_num_iterations = options_.inner_iterations;
+  const HandFitCost cost(model_, parameters.reference_rotation(), intrinsics_, std::move(terms),
+                         options_.collision_weight, options_.limit_weight, options_.prior_weight,
+                         prior_);
+  // A few hundred residual rows, ≈ 30 parameters, each row moved by a third of them or fewer:
+  // the normal equations accumulated row by row over those (Ceres formed the dense Jacobian and
+  // multiplied it out: most of the hand fit's time).
+  LevenbergMarquardtOptions solver;
+  solver.max_iterations = options_.inner_iterations;
   solver.function_tolerance = options_.inner_function_tolerance;
   // Correspondences hold only near the current pose: start with modest steps.
-  solver.initial_trust_region_radius = options_.initial_trust_radius;
-  solver.num_threads = 1;
-  solver.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
+  solver.initial_radius = options_.initial_trust_radius;
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(
+      parameters.values().data(), static_cast<Eigen::Index>(parameters.values().size()));
+  MinimiseLevenbergMarquardt(
+      [&](const Eigen::VectorXd& at, Eigen::MatrixXd* jtj, Eigen::VectorXd* jtr) {
+        return cost.NormalEquations(at.data(), jtj, jtr);
+      },
+      &x, solver);
+  std::copy(x.data(), x.data() + x.size(), parameters.values().data());
   pose_ = parameters.ToPose();
 }
 

@@ -32,43 +32,41 @@ HandFitCost::HandFitCost(const HandModel& model, const Eigen::Matrix3d& referenc
   mutable_parameter_block_sizes()->push_back(n);
 }
 
-bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
-                           double** jacobians) const {
-  const double* x = parameters[0];
+template <class Sink>
+void HandFitCost::Rows(const double* x, bool derivatives, Sink&& sink) const {
   const int n = derivatives_.size();
   derivatives_.Evaluate(reference_, x);
-  double* jacobian = jacobians ? jacobians[0] : nullptr;
-  if (jacobian) std::fill(jacobian, jacobian + static_cast<size_t>(num_residuals()) * n, 0.0);
-  int row = 0;
-  std::vector<double> point_jacobian(3 * n);
+  std::vector<double> point_jacobian(3 * n), jacobian_b(3 * n), gradient(n);
+  std::vector<int> columns;
+  double* const jp = derivatives ? point_jacobian.data() : nullptr;
   auto skinned = [&](int vertex) {
-    return derivatives_.SkinnedPoint(model_.weights[vertex], model_.rest_mesh.vertices[vertex],
-                                     jacobian ? point_jacobian.data() : nullptr);
+    if (derivatives) derivatives_.Columns(model_.weights[vertex], &columns);
+    return derivatives_.SkinnedPoint(model_.weights[vertex], model_.rest_mesh.vertices[vertex], jp);
+  };
+  // Row r of the point's Jacobian times `w`, over the point's columns.
+  auto scaled_row = [&](int r, double w) {
+    if (!derivatives) return;
+    for (int c : columns) gradient[c] = w * point_jacobian[r * n + c];
   };
   for (const PointPair& pair : terms_.points) {
     const Eigen::Vector3d p = skinned(pair.vertex);
     for (int r = 0; r < 3; ++r) {
-      residuals[row + r] = pair.weight * (p[r] - pair.target[r]);
-      if (jacobian) {
-        for (int c = 0; c < n; ++c)
-          jacobian[(row + r) * n + c] = pair.weight * point_jacobian[r * n + c];
-      }
+      scaled_row(r, pair.weight);
+      sink(pair.weight * (p[r] - pair.target[r]), gradient.data(), columns);
     }
-    row += 3;
   }
   for (const PlanePair& pair : terms_.planes) {
     const Eigen::Vector3d p = skinned(pair.vertex);
     const Eigen::Vector3d& normal = pair.normal;
     if (pair.point_weight <= 0) {
-      residuals[row] = pair.weight * normal.dot(p - pair.target);
-      if (jacobian) {
-        for (int c = 0; c < n; ++c) {
+      if (derivatives) {
+        for (int c : columns) {
           double d = 0;
           for (int r = 0; r < 3; ++r) d += normal[r] * point_jacobian[r * n + c];
-          jacobian[row * n + c] = pair.weight * d;
+          gradient[c] = pair.weight * d;
         }
       }
-      ++row;
+      sink(pair.weight * normal.dot(p - pair.target), gradient.data(), columns);
       continue;
     }
     // A = p·I + b·n·nᵀ, b = √(p² + w²) − p: normal component weighted √(p² + w²), tangential p.
@@ -76,66 +74,104 @@ bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
     const double b = std::sqrt(a * a + pair.weight * pair.weight) - a;
     const Eigen::Vector3d residual =
         a * (p - pair.target) + b * normal.dot(p - pair.target) * normal;
-    for (int r = 0; r < 3; ++r) residuals[row + r] = residual[r];
-    if (jacobian) {
-      for (int c = 0; c < n; ++c) {
-        const Eigen::Vector3d column(point_jacobian[c], point_jacobian[n + c],
-                                     point_jacobian[2 * n + c]);
-        const Eigen::Vector3d d = a * column + b * normal.dot(column) * normal;
-        for (int r = 0; r < 3; ++r) jacobian[(row + r) * n + c] = d[r];
+    for (int r = 0; r < 3; ++r) {
+      if (derivatives) {
+        for (int c : columns) {
+          const Eigen::Vector3d column(point_jacobian[c], point_jacobian[n + c],
+                                       point_jacobian[2 * n + c]);
+          gradient[c] = a * column[r] + b * normal.dot(column) * normal[r];
+        }
       }
+      sink(residual[r], gradient.data(), columns);
     }
-    row += 3;
   }
   for (const SilhouettePair& pair : terms_.silhouette) {
     const Eigen::Vector3d p = skinned(pair.vertex);
     const double z = std::max(p.z(), 1.0), focal[2] = {intrinsics_.fx, intrinsics_.fy};
     const Eigen::Vector2d pixel = intrinsics_.Project(Eigen::Vector3d(p.x(), p.y(), z));
     for (int r = 0; r < 2; ++r) {
-      residuals[row + r] = pair.weight * (pixel[r] - pair.target[r]);
-      if (jacobian) {
-        // d(f·p_r/z + c) = f/z·dp_r − f·p_r/z²·dz.
-        for (int c = 0; c < n; ++c) {
-          jacobian[(row + r) * n + c] =
-              pair.weight * focal[r] / z *
-              (point_jacobian[r * n + c] - p[r] / z * point_jacobian[2 * n + c]);
+      // d(f·p_r/z + c) = f/z·dp_r − f·p_r/z²·dz.
+      if (derivatives) {
+        for (int c : columns) {
+          gradient[c] = pair.weight * focal[r] / z *
+                        (point_jacobian[r * n + c] - p[r] / z * point_jacobian[2 * n + c]);
         }
       }
+      sink(pair.weight * (pixel[r] - pair.target[r]), gradient.data(), columns);
     }
-    row += 2;
   }
-  std::vector<double> jacobian_b(3 * n);
+  static const std::vector<int> kNone;
   for (const CollisionPair& pair : terms_.collisions) {
-    const Eigen::Vector3d a = derivatives_.BonePoint(pair.bone_a, pair.point_a,
-                                                     jacobian ? point_jacobian.data() : nullptr);
-    const Eigen::Vector3d b =
-        derivatives_.BonePoint(pair.bone_b, pair.point_b, jacobian ? jacobian_b.data() : nullptr);
+    const Eigen::Vector3d a = derivatives_.BonePoint(pair.bone_a, pair.point_a, jp);
+    const Eigen::Vector3d b = derivatives_.BonePoint(pair.bone_b, pair.point_b,
+                                                     derivatives ? jacobian_b.data() : nullptr);
     const double distance = (a - b).norm();
     const double depth = pair.radius_a + pair.radius_b - distance;
-    residuals[row] = depth > 0 ? collision_sqrt_ * depth : 0.0;
-    if (jacobian && depth > 0 && distance > 1e-9) {
+    if (!(depth > 0)) {
+      sink(0.0, gradient.data(), kNone);
+      continue;
+    }
+    const bool moves = derivatives && distance > 1e-9;
+    if (moves) {
+      derivatives_.Columns(pair.bone_a, pair.bone_b, &columns);
       const Eigen::Vector3d normal = (a - b) / distance;
-      for (int c = 0; c < n; ++c) {
+      for (int c : columns) {
         double d = 0;
         for (int r = 0; r < 3; ++r)
           d += normal[r] * (point_jacobian[r * n + c] - jacobian_b[r * n + c]);
-        jacobian[row * n + c] = -collision_sqrt_ * d;
+        gradient[c] = -collision_sqrt_ * d;
       }
     }
-    ++row;
+    sink(collision_sqrt_ * depth, gradient.data(), moves ? columns : kNone);
   }
   for (size_t k = 0; k < dofs_.size(); ++k) {
     const auto [lo_deg, hi_deg] = model_.limits[dofs_[k].bone].limits_deg[dofs_[k].axis];
     const double angle = x[6 + k], lo = lo_deg * M_PI / 180, hi = hi_deg * M_PI / 180;
     const double excess = angle > hi ? angle - hi : (angle < lo ? angle - lo : 0.0);
-    residuals[row] = limit_weight_ * excess;
-    if (jacobian && excess != 0) jacobian[row * n + 6 + k] = limit_weight_;
-    ++row;
-    residuals[row] = prior_weight_ * (angle - prior_[k]);
-    if (jacobian) jacobian[row * n + 6 + k] = prior_weight_;
-    ++row;
+    const int c = 6 + static_cast<int>(k);
+    columns.assign({c});
+    gradient[c] = excess != 0 ? limit_weight_ : 0.0;
+    sink(limit_weight_ * excess, gradient.data(), derivatives ? columns : kNone);
+    gradient[c] = prior_weight_;
+    sink(prior_weight_ * (angle - prior_[k]), gradient.data(), derivatives ? columns : kNone);
   }
+}
+
+bool HandFitCost::Evaluate(double const* const* parameters, double* residuals,
+                           double** jacobians) const {
+  const int n = derivatives_.size();
+  double* jacobian = jacobians ? jacobians[0] : nullptr;
+  if (jacobian) std::fill(jacobian, jacobian + static_cast<size_t>(num_residuals()) * n, 0.0);
+  int row = 0;
+  Rows(parameters[0], jacobian != nullptr,
+       [&](double residual, const double* gradient, const std::vector<int>& columns) {
+         residuals[row] = residual;
+         for (int c : columns) jacobian[static_cast<size_t>(row) * n + c] = gradient[c];
+         ++row;
+       });
   return true;
+}
+
+double HandFitCost::NormalEquations(const double* x, Eigen::MatrixXd* jtj,
+                                    Eigen::VectorXd* jtr) const {
+  const int n = derivatives_.size();
+  const bool derivatives = jtj != nullptr && jtr != nullptr;
+  if (derivatives) jtj->setZero(n, n), jtr->setZero(n);
+  double cost = 0;
+  Rows(x, derivatives,
+       [&](double residual, const double* gradient, const std::vector<int>& columns) {
+         cost += 0.5 * residual * residual;
+         // The upper triangle, over the row's non-zero columns.
+         for (size_t i = 0; i < columns.size(); ++i) {
+           const int ci = columns[i];
+           const double gi = gradient[ci];
+           (*jtr)[ci] += gi * residual;
+           double* column = jtj->data() + static_cast<size_t>(ci) * n;
+           for (size_t j = 0; j <= i; ++j) column[columns[j]] += gi * gradient[columns[j]];
+         }
+       });
+  if (derivatives) jtj->triangularView<Eigen::StrictlyLower>() = jtj->transpose().eval();
+  return cost;
 }
 
 }  // namespace ihs::tracker

@@ -74,8 +74,18 @@ class HandFitCost : public ceres::CostFunction {
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  /// ½‖r(x)‖² at the PoseParameters vector `x`; where `jtj` and `jtr` are given, also JᵀJ and
+  /// Jᵀr (for MinimiseLevenbergMarquardt), each residual's products taken over the parameters
+  /// that move it only (the root's six and its bones' chains: a third of them or fewer).
+  double NormalEquations(const double* x, Eigen::MatrixXd* jtj, Eigen::VectorXd* jtr) const;
 
  private:
+  // Evaluates the residuals at `x` in Evaluate's order and hands each to `sink(residual,
+  // gradient, columns)`: with `derivatives`, gradient[c] for c in columns (ascending) holds the
+  // row's non-zero derivatives (elsewhere it is undefined); without, columns is empty.
+  template <class Sink>
+  void Rows(const double* x, bool derivatives, Sink&& sink) const;
+
   const HandModel& model_;
   const Eigen::Matrix3d reference_;
   const CameraIntrinsics intrinsics_;

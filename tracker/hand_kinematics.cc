@@ -1,6 +1,7 @@
 #include "tracker/hand_kinematics.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "core/check.h"
@@ -132,6 +133,30 @@ Eigen::Vector3d PoseDerivatives::BonePoint(int bone, const Eigen::Vector3d& in_b
     AccumulateJacobian(bone, 1.0, moved, jacobian);
   }
   return moved;
+}
+
+namespace {
+
+// Adds `more` (ascending) to the ascending `columns`, keeping them ascending and unique.
+void MergeColumns(const std::vector<int>& more, std::vector<int>* columns) {
+  const size_t before = columns->size();
+  columns->insert(columns->end(), more.begin(), more.end());
+  std::inplace_merge(columns->begin(), columns->begin() + static_cast<std::ptrdiff_t>(before),
+                     columns->end());
+  columns->erase(std::unique(columns->begin(), columns->end()), columns->end());
+}
+
+}  // namespace
+
+void PoseDerivatives::Columns(const VertexWeights& weights, std::vector<int>* columns) const {
+  columns->assign({0, 1, 2, 3, 4, 5});
+  for (const auto& [bone, weight] : weights.bones) MergeColumns(moving_dofs_[bone], columns);
+}
+
+void PoseDerivatives::Columns(int bone_a, int bone_b, std::vector<int>* columns) const {
+  columns->assign({0, 1, 2, 3, 4, 5});
+  MergeColumns(moving_dofs_[bone_a], columns);
+  MergeColumns(moving_dofs_[bone_b], columns);
 }
 
 }  // namespace ihs::tracker

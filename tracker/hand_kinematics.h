@@ -51,6 +51,11 @@ class PoseDerivatives {
   /// A point fixed in bone `bone`'s frame, in the camera frame; optionally with its Jacobian.
   Eigen::Vector3d BonePoint(int bone, const Eigen::Vector3d& in_bone, double* jacobian) const;
 
+  /// The parameters that move a point of `bones` (ascending, into `columns`): the root's six and
+  /// the degrees of freedom of each bone and its ancestors. Its Jacobian is zero elsewhere.
+  void Columns(const VertexWeights& weights, std::vector<int>* columns) const;
+  void Columns(int bone_a, int bone_b, std::vector<int>* columns) const;
+
  private:
   // Adds w·∂(cam_from_bone[bone]·p)/∂params to `jacobian`, given the moved point `moved`.
   void AccumulateJacobian(int bone, double w, const Eigen::Vector3d& moved, double* jacobian) const;

@@ -101,6 +101,21 @@ void CheckGradients(const HandModel& model, std::mt19937& rng) {
     }
   }
   EXPECT_EQ(bad, 0);
+
+  // The normal equations accumulated over each row's moving parameters are the dense
+  // Jacobian's: JᵀJ, Jᵀr and ½‖r‖².
+  const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+      dense(jacobian.data(), m, n);
+  const Eigen::Map<const Eigen::VectorXd> r(residuals.data(), m);
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
+  const double value = cost.NormalEquations(parameters.values().data(), &jtj, &jtr);
+  EXPECT_NEAR(value, 0.5 * r.squaredNorm(), 1e-9 * r.squaredNorm());
+  const Eigen::MatrixXd expected_jtj = dense.transpose() * dense;
+  const Eigen::VectorXd expected_jtr = dense.transpose() * r;
+  EXPECT_LE((jtj - expected_jtj).norm(), 1e-9 * expected_jtj.norm());
+  EXPECT_LE((jtr - expected_jtr).norm(), 1e-9 * expected_jtr.norm());
+  EXPECT_EQ(cost.NormalEquations(parameters.values().data(), nullptr, nullptr), value);
 }
 
 // A plane pair with a point weight costs exactly what the plane pair and a separate point pair
