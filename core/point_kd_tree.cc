@@ -45,6 +45,20 @@ int PointKdTree::Nearest(const Eigen::Vector3f& query, float* distance_sq) const
   return static_cast<int>(index);
 }
 
+int PointKdTree::NearestWithin(const Eigen::Vector3f& query, float max_distance_sq,
+                               float* distance_sq) const {
+  if (index_->cloud.points.empty()) return -1;
+  std::uint32_t index = 0;
+  float d2 = 0;
+  nanoflann::KNNResultSet<float, std::uint32_t> result(1);
+  result.init(&index, &d2);
+  d2 = max_distance_sq;  // The worst distance the search keeps: only nearer points are added.
+  index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
+  if (result.size() == 0) return -1;
+  if (distance_sq) *distance_sq = d2;
+  return static_cast<int>(index);
+}
+
 int PointKdTree::CountWithin(const Eigen::Vector3f& query, float radius_mm) const {
   if (index_->cloud.points.empty()) return 0;
   std::vector<std::pair<std::uint32_t, float>> matches;

@@ -20,6 +20,10 @@ class PointKdTree {
   int Nearest(const Eigen::Vector3f& query, float* distance_sq) const;
   /// Number of points within `radius_mm` of `query`.
   int CountWithin(const Eigen::Vector3f& query, float radius_mm) const;
+  /// The nearest point nearer than √`max_distance_sq` (its squared distance in `distance_sq`),
+  /// or −1 when there is none: Nearest's answer where that is within the bound, found without
+  /// looking beyond it (a capped distance needs no more).
+  int NearestWithin(const Eigen::Vector3f& query, float max_distance_sq, float* distance_sq) const;
 
   const std::vector<Eigen::Vector3f>& points() const;
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <queue>
 
 #include "core/check.h"
 #include "core/point_kd_tree.h"
@@ -78,41 +79,55 @@ class Placement {
         options_(options) {}
 
   // `cam_from_model` moved by `iterations` of rigid ICP onto the hand points; its score in
-  // `score`. Every `stride`-th point is used (a quick look: 3).
-  Rigid3 Place(Rigid3 cam_from_model, int iterations, int stride, double* score) const {
+  // `score` where given. Every `stride`-th point is used (a quick look: 3). A score that would
+  // come out above `bound` may be given as infinity instead (Score).
+  Rigid3 Place(Rigid3 cam_from_model, int iterations, int stride, double* score,
+               double bound = std::numeric_limits<double>::infinity()) const {
     for (int iteration = 0; iteration < iterations; ++iteration) {
       std::vector<Eigen::Vector3d> from, to;
       Pairs(cam_from_model, stride, &from, &to);
       if (from.size() < 3) break;
       cam_from_model = FitRigidTransform(from, to);
     }
-    *score = Score(cam_from_model, stride);
+    if (score) *score = Score(cam_from_model, stride, bound);
     return cam_from_model;
   }
 
-  // The mean capped distance of the data to the model and of the visible model to the data.
-  double Score(const Rigid3& cam_from_model, int stride) const {
+  // The mean capped distance of the data to the model and of the visible model to the data;
+  // infinity as soon as the sums so far show that it exceeds `bound` (each mean is at least its
+  // partial sum over all the points it may average).
+  double Score(const Rigid3& cam_from_model, int stride, double bound) const {
     const double cap = options_.score_cap_mm;
+    const float cap_sq = static_cast<float>(cap * cap);
+    auto capped = [&](const PointKdTree& tree, const Eigen::Vector3d& p) {
+      float d2 = 0;
+      return tree.NearestWithin(p.cast<float>(), cap_sq, &d2) < 0
+                 ? cap
+                 : std::min(cap, std::sqrt(static_cast<double>(d2)));
+    };
     const Rigid3 model_from_cam = cam_from_model.Inverse();
+    const size_t data_count = (data_sample_.size() + stride - 1) / stride;
+    const size_t model_count = (model_sample_.size() + stride - 1) / stride;
+    constexpr double kInfinity = std::numeric_limits<double>::infinity();
     double data_sum = 0;
     int data = 0;
     for (size_t i = 0; i < data_sample_.size(); i += stride, ++data) {
-      float d2 = 0;
-      model_tree_.Nearest((model_from_cam * data_sample_[i]).cast<float>(), &d2);
-      data_sum += std::min(cap, std::sqrt(static_cast<double>(d2)));
+      data_sum += capped(model_tree_, model_from_cam * data_sample_[i]);
+      if (data_sum > bound * data_count) return kInfinity;
     }
+    if (data == 0) return kInfinity;
+    const double data_mean = data_sum / data;
     double model_sum = 0;
     int visible = 0;
     for (size_t i = 0; i < model_sample_.size(); i += stride) {
       const Eigen::Vector3d p = cam_from_model * Eigen::Vector3d(model_sample_[i].cast<double>());
       if (Hidden(p)) continue;
-      float d2 = 0;
-      data_tree_.Nearest(p.cast<float>(), &d2);
-      model_sum += std::min(cap, std::sqrt(static_cast<double>(d2)));
+      model_sum += capped(data_tree_, p);
       ++visible;
+      if (data_mean + model_sum / model_count > bound) return kInfinity;
     }
-    if (visible == 0 || data == 0) return std::numeric_limits<double>::infinity();
-    return data_sum / data + model_sum / visible;
+    if (visible == 0) return kInfinity;
+    return data_mean + model_sum / visible;
   }
 
  private:
@@ -126,40 +141,57 @@ class Placement {
     return depth > 0 && depth < p.z() - kHiddenMm;
   }
 
-  // Nearest pairs both ways (model point, data point), the nearest share of each kept.
+  // Nearest pairs both ways (model point, data point), the nearest share of each kept. A
+  // query is first answered within the score's cap only: when the share kept is found within
+  // it, the pairs beyond it are not kept whatever they are (and only otherwise looked for).
   void Pairs(const Rigid3& cam_from_model, int stride, std::vector<Eigen::Vector3d>* from,
              std::vector<Eigen::Vector3d>* to) const {
     struct Pair {
       float distance_sq;
       Eigen::Vector3d model, data;
     };
-    auto keep_nearest = [&](std::vector<Pair>& pairs) {
+    const float cap_sq = static_cast<float>(options_.score_cap_mm * options_.score_cap_mm);
+    constexpr float kBeyond = std::numeric_limits<float>::infinity();
+    // Pairs `query`'s points (placed by `place`) with `tree`'s, `model_side`: whether the
+    // queries are the model's points.
+    auto pair_up = [&](const std::vector<Eigen::Vector3d>& queries, const PointKdTree& tree,
+                       const auto& place, const auto& accept, bool model_side) {
+      std::vector<Pair> pairs;
+      std::vector<size_t> beyond;  // Indices into pairs of queries with nothing within the cap.
+      for (size_t k = 0; k < queries.size(); k += stride) {
+        const Eigen::Vector3d p = place(queries[k]);
+        if (!accept(p)) continue;
+        float d2 = 0;
+        const int i = tree.NearestWithin(p.cast<float>(), cap_sq, &d2);
+        const Eigen::Vector3d found = i < 0 ? p : tree.points()[i].cast<double>();
+        if (i < 0) beyond.push_back(pairs.size()), d2 = kBeyond;
+        pairs.push_back(model_side ? Pair{d2, queries[k], found} : Pair{d2, found, queries[k]});
+      }
       const size_t kept = static_cast<size_t>(kKeptShare * pairs.size());
       if (kept == 0) return;
+      if (pairs.size() - beyond.size() < kept) {
+        for (size_t b : beyond) {
+          Pair& pair = pairs[b];
+          const Eigen::Vector3d p = place(model_side ? pair.model : pair.data);
+          const int i = tree.Nearest(p.cast<float>(), &pair.distance_sq);
+          (model_side ? pair.data : pair.model) = tree.points()[i].cast<double>();
+        }
+      }
       std::nth_element(pairs.begin(), pairs.begin() + (kept - 1), pairs.end(),
                        [](const Pair& a, const Pair& b) { return a.distance_sq < b.distance_sq; });
       for (size_t k = 0; k < kept; ++k)
         from->push_back(pairs[k].model), to->push_back(pairs[k].data);
     };
     const Rigid3 model_from_cam = cam_from_model.Inverse();
-    std::vector<Pair> pairs;
-    for (size_t k = 0; k < data_sample_.size(); k += stride) {
-      float d2 = 0;
-      const Eigen::Vector3d& p = data_sample_[k];
-      const int i = model_tree_.Nearest((model_from_cam * p).cast<float>(), &d2);
-      pairs.push_back({d2, model_tree_.points()[i].cast<double>(), p});
-    }
-    keep_nearest(pairs);
-    pairs.clear();
-    for (size_t k = 0; k < model_sample_.size(); k += stride) {
-      const Eigen::Vector3d model = model_sample_[k].cast<double>();
-      const Eigen::Vector3d p = cam_from_model * model;
-      if (Hidden(p)) continue;
-      float d2 = 0;
-      const int i = data_tree_.Nearest(p.cast<float>(), &d2);
-      pairs.push_back({d2, model, data_tree_.points()[i].cast<double>()});
-    }
-    keep_nearest(pairs);
+    pair_up(
+        data_sample_, model_tree_, [&](const Eigen::Vector3d& p) { return model_from_cam * p; },
+        [](const Eigen::Vector3d&) { return true; }, false);
+    std::vector<Eigen::Vector3d> model_points;
+    model_points.reserve(model_sample_.size());
+    for (const Eigen::Vector3f& m : model_sample_) model_points.push_back(m.cast<double>());
+    pair_up(
+        model_points, data_tree_, [&](const Eigen::Vector3d& m) { return cam_from_model * m; },
+        [&](const Eigen::Vector3d& p) { return !Hidden(p); }, true);
   }
 
   const PointKdTree model_tree_;
@@ -282,6 +314,10 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     return side->Penalty(placed, right_hand);
   };
   std::vector<Start> starts;
+  // The best `to_place` coarse scores so far (the worst of them on top): the starts placed fully.
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  const size_t to_place = 4 * static_cast<size_t>(count);
+  std::priority_queue<double> best_kept;
   std::vector<std::unique_ptr<Placement>> placements;
   std::vector<HandPose> poses;
   std::vector<std::pair<HandPose, bool>> sources;  // An articulation; whether it was tracked.
@@ -317,9 +353,17 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     palms.push_back(
         PalmAxesOf(model_, model_.JointPositions(ForwardKinematics(model_, articulation))));
     auto add = [&](const Rigid3& start) {
-      double score = 0;
-      const Rigid3 placed = placements.back()->Place(start, 1, 3, &score);
-      starts.push_back({index, placed, score + side_penalty(index, placed)});
+      const Rigid3 placed = placements.back()->Place(start, 1, 3, nullptr);
+      const double penalty = side_penalty(index, placed);
+      // A start scored above the best `to_place` so far cannot be among them: its score is cut
+      // short.
+      const double bound = best_kept.size() < to_place ? kInfinity : best_kept.top();
+      const double score = placements.back()->Score(placed, 3, bound - penalty) + penalty;
+      starts.push_back({index, placed, score});
+      if (best_kept.size() < to_place || score < best_kept.top()) {
+        best_kept.push(score);
+        if (best_kept.size() > to_place) best_kept.pop();
+      }
     };
     for (const Eigen::Matrix3d& rotation : rotations)
       add(Rigid3(rotation, centre - rotation * model_centre));
@@ -333,7 +377,7 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
   }
   // The best of them placed fully.
   auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };
-  const size_t placed = std::min<size_t>(starts.size(), 4 * static_cast<size_t>(count));
+  const size_t placed = std::min<size_t>(starts.size(), to_place);
   std::partial_sort(starts.begin(), starts.begin() + placed, starts.end(), by_score);
   for (size_t k = 0; k < placed; ++k) {
     SearchHypothesis hypothesis;
