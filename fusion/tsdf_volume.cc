@@ -128,9 +128,7 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   const bool color = options_.color && frame.HasColor();
   int updated = 0;
   // In memory order (the bits' order), which the caches like far better than the rays' order.
-  auto update = [&](std::int64_t index) {
-    const int i = static_cast<int>(index % n_), j = static_cast<int>((index / n_) % n_),
-              k = static_cast<int>(index / (static_cast<std::int64_t>(n_) * n_));
+  auto update = [&](std::int64_t index, int i, int j, int k) {
     const Eigen::Vector3f centre = cam_rotation * Centre(i, j, k) + cam_translation;
     if (centre.z() <= 0) return;
     const float x = static_cast<float>(intrinsics.fx) * centre.x() / centre.z() +
@@ -166,11 +164,24 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
     }
     ++updated;
   };
+  // A word's first voxel's (i, j, k) by division, its bits' by counting on from there (three
+  // 64-bit divisions per voxel before: the integration 4-6 % slower on two scripted turns).
+  const std::int64_t slice = static_cast<std::int64_t>(n_) * n_;
   for (std::int64_t w = first_word; w <= last_word; ++w) {
     std::uint64_t bits = touched_bits_[w];
     if (bits == 0) continue;
     touched_bits_[w] = 0;
-    for (; bits != 0; bits &= bits - 1) update(w * 64 + std::countr_zero(bits));
+    const std::int64_t first = w * 64;
+    const int i0 = static_cast<int>(first % n_), j0 = static_cast<int>((first / n_) % n_),
+              k0 = static_cast<int>(first / slice);
+    for (; bits != 0; bits &= bits - 1) {
+      const int bit = std::countr_zero(bits);
+      int i = i0 + bit, j = j0, k = k0;
+      for (; i >= n_; i -= n_) {
+        if (++j == n_) j = 0, ++k;
+      }
+      update(first + bit, i, j, k);
+    }
   }
   return updated;
 }
