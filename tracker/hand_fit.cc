@@ -514,10 +514,15 @@ std::vector<CollisionPair> HandFitter::FitState::CloseCollisions() const {
 // Once the samples are posed at the initial pose: the silhouette, the region around the
 // model's image, and each of its pixels' nearest silhouette pixel.
 void HandFitter::FitState::PrepareSilhouette() {
-  silhouette_.resize(segmentation_->hand_mask.size());
-  for (size_t p = 0; p < silhouette_.size(); ++p)
-    silhouette_[p] = segmentation_->hand_mask[p] | segmentation_->object_mask[p];
+  // Only the region around the model's image is read (the nearest pixels are looked for there).
   roi_ = ModelImageRoi();
+  silhouette_.assign(segmentation_->hand_mask.size(), 0);
+  for (int v = roi_[1]; v < roi_[3]; ++v) {
+    for (int u = roi_[0]; u < roi_[2]; ++u) {
+      const size_t p = static_cast<size_t>(v) * segmentation_->width + u;
+      silhouette_[p] = segmentation_->hand_mask[p] | segmentation_->object_mask[p];
+    }
+  }
   if (options_.unlabelled_match_mm > 0 && frame_ != nullptr &&
       frame_->depth_mm.size() == silhouette_.size()) {
     AddUnlabelledToSilhouette();

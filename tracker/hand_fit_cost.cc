@@ -36,7 +36,7 @@ template <class Sink>
 void HandFitCost::Rows(const double* x, bool derivatives, Sink&& sink) const {
   const int n = derivatives_.size();
   derivatives_.Evaluate(reference_, x);
-  std::vector<double> point_jacobian(3 * n), jacobian_b(3 * n), gradient(n);
+  std::vector<double> point_jacobian(3 * n), jacobian_b(3 * n), gradient(n), rows3(3 * n);
   std::vector<int> columns;
   double* const jp = derivatives ? point_jacobian.data() : nullptr;
   auto skinned = [&](int vertex) {
@@ -74,16 +74,15 @@ void HandFitCost::Rows(const double* x, bool derivatives, Sink&& sink) const {
     const double b = std::sqrt(a * a + pair.weight * pair.weight) - a;
     const Eigen::Vector3d residual =
         a * (p - pair.target) + b * normal.dot(p - pair.target) * normal;
-    for (int r = 0; r < 3; ++r) {
-      if (derivatives) {
-        for (int c : columns) {
-          const Eigen::Vector3d column(point_jacobian[c], point_jacobian[n + c],
-                                       point_jacobian[2 * n + c]);
-          gradient[c] = a * column[r] + b * normal.dot(column) * normal[r];
-        }
+    if (derivatives) {
+      for (int c : columns) {
+        const Eigen::Vector3d column(point_jacobian[c], point_jacobian[n + c],
+                                     point_jacobian[2 * n + c]);
+        const double along_normal = b * normal.dot(column);
+        for (int r = 0; r < 3; ++r) rows3[r * n + c] = a * column[r] + along_normal * normal[r];
       }
-      sink(residual[r], gradient.data(), columns);
     }
+    for (int r = 0; r < 3; ++r) sink(residual[r], rows3.data() + r * n, columns);
   }
   for (const SilhouettePair& pair : terms_.silhouette) {
     const Eigen::Vector3d p = skinned(pair.vertex);
