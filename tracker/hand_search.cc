@@ -64,6 +64,13 @@ void PrincipalAxes(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d* 
   if (axes->determinant() < 0) axes->col(2) *= -1;
 }
 
+std::vector<Eigen::Vector3d> ToDouble(const std::vector<Eigen::Vector3f>& points) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) out.push_back(p.cast<double>());
+  return out;
+}
+
 // One articulation's model points and the hand points, for placing and scoring rigid poses.
 class Placement {
  public:
@@ -71,7 +78,7 @@ class Placement {
             const std::vector<Eigen::Vector3d>& data_sample, const Frame& frame,
             const CameraIntrinsics& intrinsics, const HandSearchOptions& options)
       : model_tree_(Thinned(model_vertices, 6 * options.sample_points)),
-        model_sample_(Thinned(model_vertices, 3 * options.sample_points)),
+        model_sample_(ToDouble(Thinned(model_vertices, 3 * options.sample_points))),
         data_tree_(data_tree),
         data_sample_(data_sample),
         frame_(frame),
@@ -120,7 +127,7 @@ class Placement {
     double model_sum = 0;
     int visible = 0;
     for (size_t i = 0; i < model_sample_.size(); i += stride) {
-      const Eigen::Vector3d p = cam_from_model * Eigen::Vector3d(model_sample_[i].cast<double>());
+      const Eigen::Vector3d p = cam_from_model * model_sample_[i];
       if (Hidden(p)) continue;
       model_sum += capped(data_tree_, p);
       ++visible;
@@ -186,16 +193,13 @@ class Placement {
     pair_up(
         data_sample_, model_tree_, [&](const Eigen::Vector3d& p) { return model_from_cam * p; },
         [](const Eigen::Vector3d&) { return true; }, false);
-    std::vector<Eigen::Vector3d> model_points;
-    model_points.reserve(model_sample_.size());
-    for (const Eigen::Vector3f& m : model_sample_) model_points.push_back(m.cast<double>());
     pair_up(
-        model_points, data_tree_, [&](const Eigen::Vector3d& m) { return cam_from_model * m; },
+        model_sample_, data_tree_, [&](const Eigen::Vector3d& m) { return cam_from_model * m; },
         [&](const Eigen::Vector3d& p) { return !Hidden(p); }, true);
   }
 
   const PointKdTree model_tree_;
-  const std::vector<Eigen::Vector3f> model_sample_;
+  const std::vector<Eigen::Vector3d> model_sample_;
   const PointKdTree& data_tree_;
   const std::vector<Eigen::Vector3d>& data_sample_;
   const Frame& frame_;
@@ -328,9 +332,8 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     articulation.cam_from_root = Rigid3();
     const std::vector<Eigen::Vector3f> vertices =
         model_.Pose(ForwardKinematics(model_, articulation)).vertices;
-    std::vector<Eigen::Vector3d> model_points;
-    for (const Eigen::Vector3f& v : Thinned(vertices, 3 * options_.sample_points))
-      model_points.push_back(v.cast<double>());
+    const std::vector<Eigen::Vector3d> model_points =
+        ToDouble(Thinned(vertices, 3 * options_.sample_points));
     Eigen::Vector3d model_centre;
     Eigen::Matrix3d model_axes;
     PrincipalAxes(model_points, &model_centre, &model_axes);
