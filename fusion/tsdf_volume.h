@@ -13,6 +13,7 @@
 
 #include "core/camera_intrinsics.h"
 #include "core/frame.h"
+#include "core/huge_pages.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 
@@ -118,9 +119,10 @@ class TsdfVolume {
   std::array<int, 3> observed_hi_ = {-1, -1, -1};
   const double voxel_mm_;
   const double truncation_mm_;
-  std::vector<Voxel> voxels_;
+  // Both are read at scattered places: in huge pages (core/huge_pages.h).
+  std::vector<Voxel, HugePageAllocator<Voxel>> voxels_;
   // Scratch for Integrate: one bit per voxel, all zero between calls.
-  std::vector<std::uint64_t> touched_bits_;
+  std::vector<std::uint64_t, HugePageAllocator<std::uint64_t>> touched_bits_;
 };
 
 }  // namespace ihs::fusion
