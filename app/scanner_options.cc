@@ -267,6 +267,9 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
         "those starts' palm normal also tilted this much four ways, degrees");
   r.Add("tracker.search.score_cap_mm", &t.search.score_cap_mm,
         "largest distance a search hypothesis's score counts per point, mm");
+  r.Add("tracker.search.threads", &t.search.threads,
+        "threads placing a search's starts (0: one per core; the same result whatever the "
+        "number)");
   r.Add("tracker.search_candidates", &t.search_candidates,
         "a search's best placed hypotheses that the hand fit tries");
   r.Add("tracker.search_coarse_iterations", &t.search_coarse_iterations,

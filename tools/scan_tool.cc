@@ -157,7 +157,8 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
   std::printf(
-      "ms per frame (one core): track %.1f, mask %.1f, features %.1f, fusion %.1f (pairwise %.2f, "
+      "ms per frame (one thread; a hand search on every core): track %.1f, mask %.1f, features "
+      "%.1f, fusion %.1f (pairwise %.2f, "
       "raycast %.1f, ICP %.1f, integrate %.1f)\n",
       mean("track"), mean("mask"), mean("features"), mean("fusion"), mean("pairwise"),
       mean("raycast"), mean("icp"), mean("integrate"));
@@ -168,12 +169,13 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
       meshes.bound_ms);
   std::printf("mesh: %s (%zu faces, %s)\n", (out / "mesh.ply").c_str(),
               meshes.watertight.faces.size(),
-              meshes.IsWatertight()                 ? "watertight"
+              meshes.IsWatertight()              ? "watertight"
               : meshes.watertight.IsWatertight() ? "closed but crossing itself: NOT watertight"
                                                  : "NOT watertight");
-  std::printf("coverage: seen from %.1f %% of the directions around it, %.1f %% of the "
-              "watertight mesh never seen\n",
-              100 * record.coverage(), 100 * meshes.unseen_share);
+  std::printf(
+      "coverage: seen from %.1f %% of the directions around it, %.1f %% of the "
+      "watertight mesh never seen\n",
+      100 * record.coverage(), 100 * meshes.unseen_share);
   if (meshes.cut_share > 0) {
     std::printf(
         "closure: %.1f %% of Poisson's volume cut away where the views saw empty space "

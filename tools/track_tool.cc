@@ -207,7 +207,8 @@ class TrackLog {
                 : hand.scale_at_bound() ? "estimated over the first frames, on a bound of its range"
                                         : "estimated over the first frames");
     std::printf(
-        "time per frame: %.1f ms mean, %.1f ms p95 (one core); segmentation %.1f, fit %.1f, "
+        "time per frame: %.1f ms mean, %.1f ms p95 (one thread; a search on every core); "
+        "segmentation %.1f, fit %.1f, "
         "contacts %.1f ms\n",
         summary["ms_mean"].get<double>(), summary["ms_p95"].get<double>(),
         summary["segmentation_ms_mean"].get<double>(), summary["fit_ms_mean"].get<double>(),

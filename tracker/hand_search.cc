@@ -9,6 +9,7 @@
 #include <queue>
 
 #include "core/check.h"
+#include "core/parallel_runs.h"
 #include "core/point_kd_tree.h"
 #include "core/rigid_fit.h"
 
@@ -276,6 +277,7 @@ void HandSearchOptions::Check() const {
                 "tracker.search.grasp_rolls must be in [0, 360]");
   IHS_CHECK_ARG(grasp_tilt_deg >= 0 && grasp_tilt_deg <= 90,
                 "tracker.search.grasp_tilt_deg must be in [0, 90]");
+  IHS_CHECK_ARG(threads >= 0 && threads <= 256, "tracker.search.threads must be in [0, 256]");
 }
 
 HandSearch::HandSearch(const HandModel& model, const CameraIntrinsics& intrinsics,
@@ -302,28 +304,16 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
   // The points are the hand's near surface: its middle lies a little farther along the ray.
   const Eigen::Vector3d centre = data_centre + 8.0 * data_centre.normalized();
 
-  // Every start placed roughly (one ICP iteration) and scored.
+  // Every articulation's placement and starts.
   struct Start {
     int articulation;
     Rigid3 cam_from_model;
-    double score;
+    double score = 0;
   };
-  // The grasp side's penalty of articulation `index` placed at `cam_from_model`.
   std::vector<PalmAxes> palms;  // Per articulation, in the model's frame.
-  auto side_penalty = [&](int index, const Rigid3& cam_from_model) {
-    if (side == nullptr) return 0.0;
-    const PalmAxes& palm = palms[static_cast<size_t>(index)];
-    const PalmAxes placed{cam_from_model.rotation() * palm.across,
-                          cam_from_model.rotation() * palm.along, cam_from_model * palm.centre};
-    return side->Penalty(placed, right_hand);
-  };
-  std::vector<Start> starts;
-  // The best `to_place` coarse scores so far (the worst of them on top): the starts placed fully.
-  constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  const size_t to_place = 4 * static_cast<size_t>(count);
-  std::priority_queue<double> best_kept;
   std::vector<std::unique_ptr<Placement>> placements;
   std::vector<HandPose> poses;
+  std::vector<Start> starts;
   std::vector<std::pair<HandPose, bool>> sources;  // An articulation; whether it was tracked.
   for (const HandPose& pose : articulations) sources.emplace_back(pose, false);
   for (const HandPose& pose : tracked) sources.emplace_back(pose, true);
@@ -355,45 +345,76 @@ std::vector<SearchHypothesis> HandSearch::Best(const std::vector<Eigen::Vector3f
     poses.push_back(articulation);
     palms.push_back(
         PalmAxesOf(model_, model_.JointPositions(ForwardKinematics(model_, articulation))));
-    auto add = [&](const Rigid3& start) {
-      const Rigid3 placed = placements.back()->Place(start, 1, 3, nullptr);
-      const double penalty = side_penalty(index, placed);
-      // A start scored above the best `to_place` so far cannot be among them: its score is cut
-      // short.
-      const double bound = best_kept.size() < to_place ? kInfinity : best_kept.top();
-      const double score = placements.back()->Score(placed, 3, bound - penalty) + penalty;
-      starts.push_back({index, placed, score});
-      if (best_kept.size() < to_place || score < best_kept.top()) {
-        best_kept.push(score);
-        if (best_kept.size() > to_place) best_kept.pop();
-      }
-    };
     for (const Eigen::Matrix3d& rotation : rotations)
-      add(Rigid3(rotation, centre - rotation * model_centre));
+      starts.push_back({index, Rigid3(rotation, centre - rotation * model_centre)});
     if (side != nullptr && options_.grasp_rolls > 0) {
       for (const Rigid3& start :
            GraspStarts(palms.back(), right_hand, side->centre(), data_centre, options_))
-        add(start);
+        starts.push_back({index, start});
     }
     // A tracked pose is also placed from where it was.
-    if (was_tracked) add(held);
+    if (was_tracked) starts.push_back({index, held});
   }
-  // The best of them placed fully.
-  auto by_score = [](const auto& a, const auto& b) { return a.score < b.score; };
+  // The grasp side's penalty of articulation `index` placed at `cam_from_model`.
+  auto side_penalty = [&](int index, const Rigid3& cam_from_model) {
+    if (side == nullptr) return 0.0;
+    const PalmAxes& palm = palms[static_cast<size_t>(index)];
+    const PalmAxes placed{cam_from_model.rotation() * palm.across,
+                          cam_from_model.rotation() * palm.along, cam_from_model * palm.centre};
+    return side->Penalty(placed, right_hand);
+  };
+
+  // Every start placed roughly (one ICP iteration) and scored, on as many threads as the search
+  // is given. A run of starts keeps its best `to_place` coarse scores (the worst of them on top):
+  // a start scored above them cannot be among the best `to_place` overall, and its score is cut
+  // short (infinity). Those that are among them are never cut short, however the starts are
+  // split, so the result does not depend on the split.
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  const size_t to_place = 4 * static_cast<size_t>(count);
+  auto score_starts = [&](size_t begin, size_t end) {
+    std::priority_queue<double> best_kept;
+    for (size_t s = begin; s < end; ++s) {
+      Start& start = starts[s];
+      const Placement& placement = *placements[static_cast<size_t>(start.articulation)];
+      start.cam_from_model = placement.Place(start.cam_from_model, 1, 3, nullptr);
+      const double penalty = side_penalty(start.articulation, start.cam_from_model);
+      const double bound = best_kept.size() < to_place ? kInfinity : best_kept.top();
+      start.score = placement.Score(start.cam_from_model, 3, bound - penalty) + penalty;
+      if (best_kept.size() < to_place || start.score < best_kept.top()) {
+        best_kept.push(start.score);
+        if (best_kept.size() > to_place) best_kept.pop();
+      }
+    }
+  };
+  ParallelRuns(starts.size(), options_.threads, score_starts);
+
+  // The best of them placed fully (ties in start order, whatever the threads).
+  std::vector<size_t> order(starts.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
   const size_t placed = std::min<size_t>(starts.size(), to_place);
-  std::partial_sort(starts.begin(), starts.begin() + placed, starts.end(), by_score);
-  for (size_t k = 0; k < placed; ++k) {
-    SearchHypothesis hypothesis;
-    hypothesis.pose = poses[starts[k].articulation];
-    hypothesis.pose.cam_from_root = placements[starts[k].articulation]->Place(
-        starts[k].cam_from_model, options_.placement_iterations, 1, &hypothesis.score);
-    hypothesis.score += side_penalty(starts[k].articulation, hypothesis.pose.cam_from_root);
-    found.push_back(std::move(hypothesis));
-  }
+  std::partial_sort(order.begin(), order.begin() + placed, order.end(), [&](size_t a, size_t b) {
+    return starts[a].score < starts[b].score || (starts[a].score == starts[b].score && a < b);
+  });
+  found.resize(placed);
+  ParallelRuns(placed, options_.threads, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const Start& start = starts[order[k]];
+      SearchHypothesis& hypothesis = found[k];
+      hypothesis.pose = poses[static_cast<size_t>(start.articulation)];
+      hypothesis.pose.cam_from_root = placements[static_cast<size_t>(start.articulation)]->Place(
+          start.cam_from_model, options_.placement_iterations, 1, &hypothesis.score);
+      hypothesis.score += side_penalty(start.articulation, hypothesis.pose.cam_from_root);
+    }
+  });
   const size_t kept = std::min<size_t>(found.size(), count);
-  std::partial_sort(found.begin(), found.begin() + kept, found.end(), by_score);
-  found.resize(kept);
-  return found;
+  std::vector<size_t> best(found.size());
+  for (size_t k = 0; k < best.size(); ++k) best[k] = k;
+  std::partial_sort(best.begin(), best.begin() + kept, best.end(), [&](size_t a, size_t b) {
+    return found[a].score < found[b].score || (found[a].score == found[b].score && a < b);
+  });
+  std::vector<SearchHypothesis> out;
+  for (size_t k = 0; k < kept; ++k) out.push_back(std::move(found[best[k]]));
+  return out;
 }
 
 }  // namespace ihs::tracker

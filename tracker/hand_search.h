@@ -36,6 +36,10 @@ struct HandSearchOptions {
   /// grasp_tilt_deg four ways), turned about its normal in grasp_rolls steps (0: none).
   int grasp_rolls = 12;
   double grasp_tilt_deg = 25.0;
+  /// Threads that place and score the starts (0: one per core). A search stalls the tracker
+  /// for 0.6 s on one core, and meanwhile the pipeline's fusion thread has nothing to fuse; the
+  /// result is the same whatever the number.
+  int threads = 0;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/check.h"
+#include "core/parallel_runs.h"
 #include "core/point_kd_tree.h"
 #include "core/stopwatch.h"
 
@@ -154,12 +155,17 @@ HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) con
 }
 
 void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& frame) {
-  for (auto& candidate : scale_candidates_) {
-    const HandFitResult fit = candidate->fitter->Fit(
-        segmentation.hand_points, &frame, Rescaled(pose_, scale_, candidate->scale), &segmentation);
-    // How far the hand points are from the model, and the model's visible points from them.
-    candidate->score += fit.data_error_mm + fit.model_error_mm;
-  }
+  // Each scale's fit is its own (on the search's threads: the first frames cost several fits).
+  ParallelRuns(scale_candidates_.size(), options_.search.threads, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      ScaleCandidate& candidate = *scale_candidates_[k];
+      const HandFitResult fit =
+          candidate.fitter->Fit(segmentation.hand_points, &frame,
+                                Rescaled(pose_, scale_, candidate.scale), &segmentation);
+      // How far the hand points are from the model, and the model's visible points from them.
+      candidate.score += fit.data_error_mm + fit.model_error_mm;
+    }
+  });
   if (++scale_frames_done_ < options_.scale_frames) return;
   size_t best = 0;
   for (size_t k = 1; k < scale_candidates_.size(); ++k) {
@@ -169,9 +175,10 @@ void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& f
   scale_at_bound_ = best == 0 || best + 1 == scale_candidates_.size();
   if (scale_at_bound_) {
     // Searching anew and estimating again did not help (docs/tracker.md): said, not retried.
-    spdlog::warn("hand scale estimate {:.2f} is on a bound of its range: the hand may be that "
-                 "size or beyond, or its first fits were wrong (scan.hand_scale sets it)",
-                 scale);
+    spdlog::warn(
+        "hand scale estimate {:.2f} is on a bound of its range: the hand may be that "
+        "size or beyond, or its first fits were wrong (scan.hand_scale sets it)",
+        scale);
   }
   if (best > 0 && best + 1 < scale_candidates_.size()) {
     // The minimum of the parabola through the best score and its neighbours.
@@ -220,24 +227,35 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
   if (has_confident_pose_) tracked.push_back(confident_pose_);
   if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad))
     tracked.push_back(pose_);
-  // The best placed hypotheses fitted briefly (with their scores); the best few fitted on.
-  std::vector<std::pair<double, HandFitResult>> coarse;
-  for (const SearchHypothesis& hypothesis :
-       search_->Best(hand_points, frame, articulations, tracked, options_.search_candidates, side,
-                     right_hand_)) {
-    HandFitResult fit = coarse_fitter_->Fit(hand_points, &frame, hypothesis.pose, segmentation);
-    coarse.emplace_back(Score(fit, side), std::move(fit));
-  }
+  // The best placed hypotheses fitted briefly (with their scores); the best few fitted on. The
+  // fits are independent: on the search's threads, each result in its hypothesis's place.
+  const std::vector<SearchHypothesis> hypotheses = search_->Best(
+      hand_points, frame, articulations, tracked, options_.search_candidates, side, right_hand_);
+  auto fit_all = [&](const HandFitter& fitter, const std::vector<const HandPose*>& starts) {
+    std::vector<std::pair<double, HandFitResult>> fits(starts.size());
+    ParallelRuns(starts.size(), options_.search.threads, [&](size_t begin, size_t end) {
+      for (size_t k = begin; k < end; ++k) {
+        fits[k].second = fitter.Fit(hand_points, &frame, *starts[k], segmentation);
+        fits[k].first = Score(fits[k].second, side);
+      }
+    });
+    return fits;
+  };
+  std::vector<const HandPose*> starts;
+  for (const SearchHypothesis& hypothesis : hypotheses) starts.push_back(&hypothesis.pose);
+  std::vector<std::pair<double, HandFitResult>> coarse = fit_all(*coarse_fitter_, starts);
   const size_t kept = std::min<size_t>(coarse.size(), options_.search_refined);
   std::partial_sort(coarse.begin(), coarse.begin() + kept, coarse.end(),
                     [](const auto& a, const auto& b) { return a.first < b.first; });
+  starts.clear();
+  for (size_t k = 0; k < kept; ++k) starts.push_back(&coarse[k].second.pose);
+  std::vector<std::pair<double, HandFitResult>> refined = fit_all(*initial_fitter_, starts);
   HandFitResult best;
   double best_score = std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < kept; ++k) {
-    HandFitResult fit =
-        initial_fitter_->Fit(hand_points, &frame, coarse[k].second.pose, segmentation);
-    const double score = Score(fit, side);
-    if (k == 0 || score < best_score) best_score = score, best = std::move(fit);
+  for (size_t k = 0; k < refined.size(); ++k) {
+    if (k == 0 || refined[k].first < best_score) {
+      best_score = refined[k].first, best = std::move(refined[k].second);
+    }
   }
   return best;
 }

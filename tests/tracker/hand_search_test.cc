@@ -21,6 +21,34 @@
 namespace ihs::tracker {
 namespace {
 
+// `pose` of `hand` seen as a z-buffer of its vertices (3×3 pixel splats) in `frame` (blank,
+// 640 × 480): returns the vertices that z-buffer shows.
+std::vector<Eigen::Vector3f> SplatHand(const HandModel& hand, const HandPose& pose,
+                                       const CameraIntrinsics& intrinsics, Frame* frame) {
+  const std::vector<Eigen::Vector3f> vertices = hand.Pose(ForwardKinematics(hand, pose)).vertices;
+  auto pixel = [&](const Eigen::Vector3f& v) {
+    const Eigen::Vector2d uv = intrinsics.Project(v.cast<double>());
+    return Eigen::Vector2i(static_cast<int>(std::lround(uv.x())),
+                           static_cast<int>(std::lround(uv.y())));
+  };
+  for (const Eigen::Vector3f& v : vertices) {
+    const Eigen::Vector2i p = pixel(v);
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        std::uint16_t& depth = frame->depth_mm[(p.y() + dv) * 640 + p.x() + du];
+        const auto z = static_cast<std::uint16_t>(std::lround(v.z()));
+        if (depth == 0 || z < depth) depth = z;
+      }
+    }
+  }
+  std::vector<Eigen::Vector3f> visible;
+  for (const Eigen::Vector3f& v : vertices) {
+    const Eigen::Vector2i p = pixel(v);
+    if (v.z() < frame->DepthAt(p.x(), p.y()) + 3.0f) visible.push_back(v);
+  }
+  return visible;
+}
+
 TEST(HandSearchTest, ACurledHandsFingertipsComeTowardThePalm) {
   const HandModel hand = MakeProceduralHand();
   auto tip_to_wrist = [&](double curl) {
@@ -90,6 +118,37 @@ TEST(HandSearchTest, FindsTheTruePoseAmongManyOrientationsFromTheHandPointsAlone
   }
 }
 
+TEST(HandSearchTest, TheSameHypothesesOnOneThreadOrSeveral) {
+  // The starts are split among the threads, each run cutting short the scores that cannot be
+  // among its best: the hypotheses must not depend on the split (a scan replayed twice gives
+  // the same hands).
+  const HandModel hand = MakeProceduralHand();
+  HandPose truth = CurledHand(hand, 0.4);
+  truth.cam_from_root =
+      Rigid3::FromAxisAngle(Eigen::Vector3d(0.3, 1, 0.2).normalized(), 2.2, {30, -20, 550});
+  const CameraIntrinsics intrinsics;
+  Frame frame = Frame::Blank(640, 480, true);
+  const std::vector<Eigen::Vector3f> visible = SplatHand(hand, truth, intrinsics, &frame);
+  auto search = [&](int threads) {
+    HandSearchOptions options;
+    options.threads = threads;
+    return HandSearch(hand, intrinsics, options)
+        .Best(visible, frame, {CurledHand(hand, 0.0), CurledHand(hand, 0.8)}, {}, 12);
+  };
+  const std::vector<SearchHypothesis> one = search(1);
+  ASSERT_EQ(one.size(), 12u);
+  for (int threads : {2, 3, 7}) {
+    const std::vector<SearchHypothesis> several = search(threads);
+    ASSERT_EQ(several.size(), one.size()) << threads << " threads";
+    for (size_t k = 0; k < one.size(); ++k) {
+      EXPECT_EQ(several[k].score, one[k].score) << threads << " threads, hypothesis " << k;
+      EXPECT_EQ(several[k].pose.angles_rad, one[k].pose.angles_rad);
+      EXPECT_TRUE(several[k].pose.cam_from_root.ToMatrix() == one[k].pose.cam_from_root.ToMatrix())
+          << threads << " threads, hypothesis " << k;
+    }
+  }
+}
+
 TEST(HandSearchTest, PlacesAHandSeenFromOneSideWhereItIs) {
   // A curled procedural hand turned and placed in front of the camera, seen as a z-buffer of
   // its vertices (3×3 pixel splats): the search must find the curl and the place from the
@@ -103,43 +162,23 @@ TEST(HandSearchTest, PlacesAHandSeenFromOneSideWhereItIs) {
         Rigid3::FromAxisAngle(Eigen::Vector3d(0.5, -0.5, 1).normalized(), 0.7, {0, 40, 450})}) {
     HandPose truth = CurledHand(hand, 0.4);
     truth.cam_from_root = cam_from_root;
-    const std::vector<Eigen::Vector3f> vertices =
-        hand.Pose(ForwardKinematics(hand, truth)).vertices;
     const CameraIntrinsics intrinsics;
     Frame frame = Frame::Blank(640, 480, true);
-    auto pixel = [&](const Eigen::Vector3f& v) {
-      const Eigen::Vector2d uv = intrinsics.Project(v.cast<double>());
-      return Eigen::Vector2i(static_cast<int>(std::lround(uv.x())),
-                             static_cast<int>(std::lround(uv.y())));
-    };
-    for (const Eigen::Vector3f& v : vertices) {
-      const Eigen::Vector2i p = pixel(v);
-      for (int dv = -1; dv <= 1; ++dv) {
-        for (int du = -1; du <= 1; ++du) {
-          std::uint16_t& depth = frame.depth_mm[(p.y() + dv) * 640 + p.x() + du];
-          const auto z = static_cast<std::uint16_t>(std::lround(v.z()));
-          if (depth == 0 || z < depth) depth = z;
-        }
-      }
-    }
-    std::vector<Eigen::Vector3f> visible;
-    for (const Eigen::Vector3f& v : vertices) {
-      const Eigen::Vector2i p = pixel(v);
-      if (v.z() < frame.DepthAt(p.x(), p.y()) + 3.0f) visible.push_back(v);
-    }
+    const std::vector<Eigen::Vector3f> vertices =
+        hand.Pose(ForwardKinematics(hand, truth)).vertices;
+    const std::vector<Eigen::Vector3f> visible = SplatHand(hand, truth, intrinsics, &frame);
     ASSERT_GT(visible.size(), vertices.size() / 10);
     ASSERT_LT(visible.size(), vertices.size() * 4 / 5);
     const HandSearch search(hand, intrinsics);
-    const std::vector<SearchHypothesis> best = search.Best(
-        visible, frame, {CurledHand(hand, 0.0), CurledHand(hand, 0.4), CurledHand(hand, 0.8)}, {},
-        2);
+    const std::vector<SearchHypothesis> best =
+        search.Best(visible, frame,
+                    {CurledHand(hand, 0.0), CurledHand(hand, 0.4), CurledHand(hand, 0.8)}, {}, 2);
     ASSERT_EQ(best.size(), 2u);
     EXPECT_EQ(best[0].pose.angles_rad, truth.angles_rad);
     const std::vector<Eigen::Vector3d> expected =
         hand.JointPositions(ForwardKinematics(hand, truth));
     auto joint_error = [&](const HandPose& pose) {
-      const std::vector<Eigen::Vector3d> found =
-          hand.JointPositions(ForwardKinematics(hand, pose));
+      const std::vector<Eigen::Vector3d> found = hand.JointPositions(ForwardKinematics(hand, pose));
       double error = 0;
       for (size_t j = 0; j < found.size(); ++j)
         error += (found[j] - expected[j]).norm() / found.size();
@@ -148,8 +187,8 @@ TEST(HandSearchTest, PlacesAHandSeenFromOneSideWhereItIs) {
     // And the articulated fit, run from there as the tracker's search runs it (two updates
     // and eight more, a loose pull toward the start's angles), brings it in.
     HandFitOptions fit_options;
-    fit_options.outer_iterations = TrackerOptions().search_coarse_iterations +
-                                   TrackerOptions().initialisation_iterations;
+    fit_options.outer_iterations =
+        TrackerOptions().search_coarse_iterations + TrackerOptions().initialisation_iterations;
     fit_options.prior_weight = 0.5;
     const HandFitResult fitted =
         HandFitter(hand, intrinsics, fit_options).Fit(visible, &frame, best[0].pose);
@@ -206,8 +245,7 @@ TEST(HandSearchTest, GraspStartsHoldTheObjectInThePalm) {
 TEST(HandSearchTest, NoPointsGiveNoHypotheses) {
   const HandModel hand = MakeProceduralHand();
   const HandSearch search(hand, CameraIntrinsics());
-  EXPECT_TRUE(
-      search.Best({}, Frame::Blank(640, 480, true), {CurledHand(hand, 0)}, {}, 5).empty());
+  EXPECT_TRUE(search.Best({}, Frame::Blank(640, 480, true), {CurledHand(hand, 0)}, {}, 5).empty());
   EXPECT_THROW(HandSearch(hand, CameraIntrinsics(), HandSearchOptions{0, 8, 6, 250, 30.0}),
                std::invalid_argument);
 }
