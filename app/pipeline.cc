@@ -163,7 +163,10 @@ void Pipeline::StartStages(const std::optional<tracker::HandPose>& initial_hand_
   const CameraIntrinsics& camera = shared_->intrinsics;
   spdlog::info("camera: {}x{} pixels, fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}", camera.width,
                camera.height, camera.fx, camera.fy, camera.cx, camera.cy);
-  shared_->hand = std::make_unique<HandStage>(options_, shared_->intrinsics);
+  // Live, a search must not stall the tracker (PipelineOptions::live_search_beside).
+  ScannerOptions hand_options = options_;
+  hand_options.tracker.search_beside = shared_->live && options_.pipeline.live_search_beside;
+  shared_->hand = std::make_unique<HandStage>(hand_options, shared_->intrinsics);
   shared_->bone_names = shared_->hand->BoneNames();
   shared_->angle_names = shared_->hand->AngleNames();
   shared_->joint_parents = {-1};
@@ -465,8 +468,8 @@ void Pipeline::ExportLoop() {
         spdlog::info(
             "exported {} ({} faces, seen from {:.0f} % of the directions around it, {:.0f} % of "
             "its surface never seen, {:.1f} s)",
-            exported.files.back().string(), exported.meshes.watertight.faces.size(),
-            100 * coverage, 100 * exported.meshes.unseen_share, exported.milliseconds / 1000.0);
+            exported.files.back().string(), exported.meshes.watertight.faces.size(), 100 * coverage,
+            100 * exported.meshes.unseen_share, exported.milliseconds / 1000.0);
         if (exported.meshes.unseen_share > kUnseenShareWarning || coverage < kCoverageWarning) {
           spdlog::warn(
               "export: the object was seen from {:.0f} % of the directions around it and {:.0f} "

@@ -245,7 +245,7 @@ std::vector<Rigid3> GraspStarts(const PalmAxes& palm, bool right_hand,
   const Eigen::Vector3d side_a = u.unitOrthogonal(), side_b = u.cross(side_a);
   const double tilt = options.grasp_tilt_deg * M_PI / 180.0;
   std::vector<Eigen::Vector3d> directions = {u};
-  for (const Eigen::Vector3d axis :
+  for (const Eigen::Vector3d& axis :
        {side_a, Eigen::Vector3d(-side_a), side_b, Eigen::Vector3d(-side_b)})
     directions.push_back(Eigen::AngleAxisd(tilt, axis) * u);
   for (const Eigen::Vector3d& direction : directions) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <optional>
 #include <string>
@@ -102,6 +103,14 @@ struct HandTracker::ScaleCandidate {
   double score = 0;
 };
 
+// A search running beside the tracking: its result, and the tracked root when it started (the
+// hand's motion since then carries the result on to the frame it is weighed in).
+struct HandTracker::PendingSearch {
+  std::future<HandFitResult> found;
+  Rigid3 cam_from_root;
+  std::int64_t frame_index = 0;
+};
+
 HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
                          TrackerOptions options)
     : base_model_(std::move(model)),
@@ -194,6 +203,10 @@ void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& f
   }
   spdlog::debug("hand scale {:.3f} from mean scores{}", scale, scores);
   scale_candidates_.clear();
+  // A search beside the tracking uses the stages rebuilt below: it is waited for and dropped
+  // (its pose is at the old scale).
+  FinishSearch();
+  pending_.reset();
   pose_ = Rescaled(pose_, scale_, scale);
   has_previous_ = false;
   previous_vertices_.clear();
@@ -215,22 +228,29 @@ double HandTracker::Score(const HandFitResult& fit, const GraspSide* side) const
   return FitScore(fit) + (side != nullptr ? side->Penalty(model_, fit.pose, right_hand_) : 0.0);
 }
 
-HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_points,
-                                  const Frame& frame, const Segmentation* segmentation,
-                                  const GraspSide* side) const {
+HandTracker::SearchStarts HandTracker::StartsOfSearch() const {
   // Articulations to place: the open hand and four curls toward a fist, the last confident
   // pose's and the one held now (a grasping hand is far from the open one: from the open hand
   // alone a search after a jump mid-grasp settled 122 mm off with 88 % of the points
   // explained); those two also from where they were.
-  std::vector<HandPose> articulations, tracked;
-  for (double curl : {0.0, 0.2, 0.4, 0.6, 0.8}) articulations.push_back(CurledHand(model_, curl));
-  if (has_confident_pose_) tracked.push_back(confident_pose_);
+  SearchStarts starts;
+  for (double curl : {0.0, 0.2, 0.4, 0.6, 0.8})
+    starts.articulations.push_back(CurledHand(model_, curl));
+  if (has_confident_pose_) starts.tracked.push_back(confident_pose_);
   if (has_pose_ && (!has_confident_pose_ || pose_.angles_rad != confident_pose_.angles_rad))
-    tracked.push_back(pose_);
+    starts.tracked.push_back(pose_);
+  return starts;
+}
+
+HandFitResult HandTracker::Search(const SearchStarts& search_starts,
+                                  const std::vector<Eigen::Vector3f>& hand_points,
+                                  const Frame& frame, const Segmentation* segmentation,
+                                  const GraspSide* side) const {
   // The best placed hypotheses fitted briefly (with their scores); the best few fitted on. The
   // fits are independent: on the search's threads, each result in its hypothesis's place.
-  const std::vector<SearchHypothesis> hypotheses = search_->Best(
-      hand_points, frame, articulations, tracked, options_.search_candidates, side, right_hand_);
+  const std::vector<SearchHypothesis> hypotheses =
+      search_->Best(hand_points, frame, search_starts.articulations, search_starts.tracked,
+                    options_.search_candidates, side, right_hand_);
   auto fit_all = [&](const HandFitter& fitter, const std::vector<const HandPose*>& starts) {
     std::vector<std::pair<double, HandFitResult>> fits(starts.size());
     ParallelRuns(starts.size(), options_.search.threads, [&](size_t begin, size_t end) {
@@ -258,6 +278,43 @@ HandFitResult HandTracker::Search(const std::vector<Eigen::Vector3f>& hand_point
     }
   }
   return best;
+}
+
+void HandTracker::StartSearchBeside(const Frame& frame, const TrackResult& result,
+                                    const std::optional<GraspSide>& side) {
+  auto pending = std::make_unique<PendingSearch>();
+  pending->cam_from_root = result.fit.pose.cam_from_root;
+  pending->frame_index = frame.index;
+  // Copies: the frame and its segmentation outlive this call only here.
+  pending->found = std::async(std::launch::async, [this, starts = StartsOfSearch(), frame = frame,
+                                                   segmentation = result.segmentation,
+                                                   side = side]() {
+    return Search(starts, segmentation.hand_points, frame, &segmentation, side ? &*side : nullptr);
+  });
+  pending_ = std::move(pending);
+}
+
+void HandTracker::WeighSearchBeside(const Frame& frame, TrackResult& result,
+                                    const GraspSide* side) {
+  const std::unique_ptr<PendingSearch> pending = std::move(pending_);
+  HandFitResult found = pending->found.get();
+  if (found.data_points == 0) return;  // No hand points: nothing was found.
+  // Where the search found the hand, moved on as the tracked root moved since.
+  HandPose start = found.pose;
+  start.cam_from_root =
+      result.fit.pose.cam_from_root * pending->cam_from_root.Inverse() * found.pose.cam_from_root;
+  HandFitResult fit =
+      initial_fitter_->Fit(result.segmentation.hand_points, &frame, start, &result.segmentation);
+  spdlog::debug("frame {}: the search begun at frame {} scores {:.2f}, the tracked fit {:.2f}",
+                frame.index, pending->frame_index, Score(fit, side), Score(result.fit, side));
+  if (Score(fit, side) < Score(result.fit, side)) {
+    result.fit = std::move(fit);
+    result.status = TrackStatus::kInitialised;
+  }
+}
+
+void HandTracker::FinishSearch() {
+  if (pending_) pending_->found.wait();
 }
 
 bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points,
@@ -313,7 +370,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
     return held ? &*held : nullptr;
   };
   if (!has_pose_) {
-    result.fit = Search(points, frame, &result.segmentation, side());
+    result.fit = Search(StartsOfSearch(), points, frame, &result.segmentation, side());
     result.status = TrackStatus::kInitialised;
   } else {
     HandPose predicted = pose_;
@@ -323,17 +380,28 @@ TrackResult HandTracker::Track(const Frame& frame) {
     }
     result.fit = fitter_->Fit(points, &frame, predicted, &result.segmentation);
     result.status = TrackStatus::kTracked;
+    // A search that ran beside the tracking and is done competes with the tracked fit.
+    if (pending_ &&
+        pending_->found.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+      WeighSearchBeside(frame, result, side());
+    }
   }
-  // A run of doubtful fits: search for the hand anew, the tracked fit competing.
+  // A run of doubtful fits: search for the hand anew, the tracked fit competing (here, or beside
+  // the tracking from the next frames on).
   doubtful_in_a_row_ =
       result.fit.data_coverage < options_.search_data_coverage ? doubtful_in_a_row_ + 1 : 0;
   if (result.status == TrackStatus::kTracked &&
       doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
     doubtful_in_a_row_ = 0;
-    HandFitResult found = Search(points, frame, &result.segmentation, side());
-    if (Score(found, side()) < Score(result.fit, side())) {
-      result.fit = std::move(found);
-      result.status = TrackStatus::kInitialised;
+    if (options_.search_beside) {
+      side();  // Finds the held object (`held`) once.
+      if (!pending_) StartSearchBeside(frame, result, held);
+    } else {
+      HandFitResult found = Search(StartsOfSearch(), points, frame, &result.segmentation, side());
+      if (Score(found, side()) < Score(result.fit, side())) {
+        result.fit = std::move(found);
+        result.status = TrackStatus::kInitialised;
+      }
     }
   }
   // Palm for back: the fit turned over, now and then, and always on a fit found from scratch.

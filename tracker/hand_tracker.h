@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,15 @@ struct TrackerOptions {
   /// guards against the held-out palm-for-back fit.
   int flip_check_frames = 10;
   double flip_tie_score = 0.5;
+  /// A search that a run of doubtful fits starts runs beside the tracking instead of stalling
+  /// it: the tracker goes on fitting each frame from its last pose, and once the search is done
+  /// its best pose (found on an older frame, moved on by the tracked root's motion since) is
+  /// fitted on the newest frame and replaces the tracked fit where it explains the hand better.
+  /// For live input (the pipeline turns it on for a live source): a search stalls the tracker
+  /// for 0.3-0.7 s, the frames arriving meanwhile are dropped, and the next frame, far from the
+  /// last fit, starts another search. Off, the same frames always give the same hands. The
+  /// first search (no pose yet) always runs in place.
+  bool search_beside = false;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -161,6 +171,11 @@ class HandTracker {
   /// Processes the next frame (depth in mm with registered colour).
   TrackResult Track(const Frame& frame);
 
+  /// Whether a search runs beside the tracking (TrackerOptions::search_beside).
+  bool searching() const { return pending_ != nullptr; }
+  /// Waits until a search running beside the tracking is done; the next Track weighs its pose.
+  void FinishSearch();
+
   /// The template at its current scale (it changes once, when the scale estimate is made).
   const HandModel& model() const { return model_; }
   double scale() const { return scale_; }
@@ -173,9 +188,24 @@ class HandTracker {
 
  private:
   struct ScaleCandidate;
-  // The fit from the search's hypotheses that explains the hand best.
-  HandFitResult Search(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
-                       const Segmentation* segmentation, const GraspSide* side) const;
+  struct PendingSearch;
+  // What a search places: the open hand and its curls, and the poses the tracker holds.
+  struct SearchStarts {
+    std::vector<HandPose> articulations, tracked;
+  };
+  SearchStarts StartsOfSearch() const;
+  // The fit from the search's hypotheses that explains the hand best. Reads only what no frame
+  // changes (the model, the fitters, the options) besides its arguments: it may run on another
+  // thread while the tracker goes on (search_beside), until the scale estimate rebuilds them.
+  HandFitResult Search(const SearchStarts& starts, const std::vector<Eigen::Vector3f>& hand_points,
+                       const Frame& frame, const Segmentation* segmentation,
+                       const GraspSide* side) const;
+  // Starts a search beside the tracking on copies of this frame's data.
+  void StartSearchBeside(const Frame& frame, const TrackResult& result,
+                         const std::optional<GraspSide>& side);
+  // A finished search's pose, moved on and fitted on this frame, replaces `result`'s fit where
+  // it explains the hand better.
+  void WeighSearchBeside(const Frame& frame, TrackResult& result, const GraspSide* side);
   // How badly `fit` explains the frame (lower is better): FitScore, and the grasp side's
   // penalty where an object is seen in the hand.
   double Score(const HandFitResult& fit, const GraspSide* side) const;
@@ -218,6 +248,9 @@ class HandTracker {
   bool has_confident_pose_ = false;
   std::vector<Eigen::Vector3f> previous_vertices_;
   std::vector<int> previous_contact_vertices_;
+  // A search running beside the tracking; last, so that it is waited for before the stages it
+  // uses go.
+  std::unique_ptr<PendingSearch> pending_;
 };
 
 }  // namespace ihs::tracker
