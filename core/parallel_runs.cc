@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -30,7 +31,13 @@ void ParallelRuns(std::size_t count, int threads,
   };
   std::vector<std::thread> workers;
   workers.reserve(runs - 1);
-  for (std::size_t r = 1; r < runs; ++r) workers.emplace_back(body, r);
+  for (std::size_t r = 1; r < runs; ++r) {
+    try {
+      workers.emplace_back(body, r);
+    } catch (const std::system_error&) {
+      body(r);  // No thread to be had (the system's limit): the run is done here instead.
+    }
+  }
   body(0);
   for (std::thread& worker : workers) worker.join();
   for (const std::exception_ptr& error : errors) {

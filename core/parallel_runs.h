@@ -13,7 +13,7 @@ namespace ihs {
 /// `threads` threads (0: one per core; the calling thread is one of them). The split depends
 /// only on `count` and the number of threads, never on timing. `run` must be safe to call
 /// concurrently on different runs. An exception thrown by a run is rethrown here after every
-/// run has finished.
+/// run has finished. Where no thread can be started, its run is done on the calling thread.
 void ParallelRuns(std::size_t count, int threads,
                   const std::function<void(std::size_t, std::size_t)>& run);
 
