@@ -403,6 +403,9 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
   r.Add("mesh.bound_box_min_face_share", &m.bound_box_min_face_share,
         "otherwise, a seen surface this much of which faces along three orthogonal directions is "
         "bounded by its box along them, not its hull (a box's unseen corner is kept; 0: never)");
+  r.Add("mesh.bound_box_outlier_share", &m.bound_box_outlier_share,
+        "the box leaves out this share of the seen surface's vertices beyond each face (a blob "
+        "of hand fused proud of a face is cut back to the face)");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
 }
 

@@ -44,9 +44,9 @@ struct Lattice {
   std::array<std::int64_t, 6> Neighbours(std::int64_t n) const {
     const auto [i, j, k] = Coordinates(n);
     const std::int64_t row = size[0], slice = static_cast<std::int64_t>(size[0]) * size[1];
-    return {i > 0 ? n - 1 : -1,         i + 1 < size[0] ? n + 1 : -1,
-            j > 0 ? n - row : -1,       j + 1 < size[1] ? n + row : -1,
-            k > 0 ? n - slice : -1,     k + 1 < size[2] ? n + slice : -1};
+    return {i > 0 ? n - 1 : -1,     i + 1 < size[0] ? n + 1 : -1,
+            j > 0 ? n - row : -1,   j + 1 < size[1] ? n + row : -1,
+            k > 0 ? n - slice : -1, k + 1 < size[2] ? n + slice : -1};
   }
   Eigen::Vector3f Point(int i, int j, int k) const {
     return origin + step * Eigen::Vector3f(static_cast<float>(i), static_cast<float>(j),
@@ -87,8 +87,7 @@ float DistanceSqToTriangle(const Eigen::Vector3f& p, const Eigen::Vector3f& a,
 // Per lattice point: −1 inside `mesh` (watertight), +1 outside, by the parity of the faces
 // crossed along z below the point.
 std::vector<std::int8_t> InsideSign(const TriangleMesh& mesh, const Lattice& lattice) {
-  std::vector<std::vector<float>> crossings(static_cast<size_t>(lattice.size[0]) *
-                                            lattice.size[1]);
+  std::vector<std::vector<float>> crossings(static_cast<size_t>(lattice.size[0]) * lattice.size[1]);
   for (const auto& face : mesh.faces) {
     Eigen::Vector3d corner[3];
     for (int c = 0; c < 3; ++c) corner[c] = mesh.vertices[face[c]].cast<double>();
@@ -110,7 +109,8 @@ std::vector<std::int8_t> InsideSign(const TriangleMesh& mesh, const Lattice& lat
         const Eigen::Vector2d p = lattice.Point(i, j, 0).head<2>().cast<double>();
         double w[3];
         if (!CoversPoint(q, p, w)) continue;
-        const double z = (w[0] * corner[0].z() + w[1] * corner[1].z() + w[2] * corner[2].z()) / area;
+        const double z =
+            (w[0] * corner[0].z() + w[1] * corner[1].z() + w[2] * corner[2].z()) / area;
         crossings[static_cast<size_t>(j) * lattice.size[0] + i].push_back(static_cast<float>(z));
       }
     }
@@ -305,14 +305,12 @@ TriangleMesh Remesh(const Lattice& lattice, const std::vector<float>& field,
   return mesh;
 }
 
-// The eight corners of the box along `axes` (orthonormal columns) that holds `points`.
+// The eight corners of the box along `axes` (orthonormal columns) that holds `points` but
+// `outlier_share` of them beyond each face.
 std::vector<Eigen::Vector3f> BoxCorners(const std::vector<Eigen::Vector3f>& points,
-                                        const Eigen::Matrix3d& axes) {
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(INFINITY), high = -low;
-  for (const Eigen::Vector3f& point : points) {
-    const Eigen::Vector3d along = axes.transpose() * point.cast<double>();
-    low = low.cwiseMin(along), high = high.cwiseMax(along);
-  }
+                                        const Eigen::Matrix3d& axes, double outlier_share) {
+  const BoxExtent extent = MeasureExtent(points, axes, outlier_share);
+  const Eigen::Vector3d &low = extent.low, &high = extent.high;
   std::vector<Eigen::Vector3f> corners;
   for (int k = 0; k < 8; ++k) {
     const Eigen::Vector3d along((k & 1) ? high.x() : low.x(), (k & 2) ? high.y() : low.y(),
@@ -343,7 +341,8 @@ ConvexHull SeenHull(const TriangleMesh& seen, const ClosureBoundOptions& options
     const BoxMeasures box = MeasureBox(seen);
     if (box.face_share >= options.box_min_face_share) {
       *shape = HullShape::kBox;
-      return ConvexHull::Of(BoxCorners(seen.vertices, box.axes), merge_mm);
+      return ConvexHull::Of(BoxCorners(seen.vertices, box.axes, options.box_outlier_share),
+                            merge_mm);
     }
   }
   return hull;

@@ -34,6 +34,10 @@ struct ClosureBoundOptions {
   /// surface: a box seen from one side shows its extent along each of its axes (its faces'
   /// widths), but not the corner behind it that the plain hull would cut off (0: never).
   double box_min_face_share = 0.8;
+  /// The box leaves out this share of the seen surface's vertices beyond each of its six faces
+  /// (MeasureExtent): what the box then cuts off the seen surface is a few vertices proud of a
+  /// face — the hand's edge or a finger fused with the object — not the box.
+  double box_outlier_share = 0.005;
   /// Pieces with fewer faces than this share of the largest one's are dropped (a cut may leave
   /// crumbs).
   double min_component_fraction = 0.05;

@@ -275,6 +275,26 @@ BoxMeasures MeasureBox(const TriangleMesh& mesh, double tolerance_deg) {
   return box;
 }
 
+BoxExtent MeasureExtent(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix3d& axes,
+                        double outlier_share) {
+  IHS_CHECK_ARG(outlier_share >= 0 && outlier_share < 0.5,
+                "the extent's outlier share must be in [0, 0.5), got " << outlier_share);
+  BoxExtent extent;
+  if (points.empty()) return extent;
+  const size_t left_out = static_cast<size_t>(outlier_share * static_cast<double>(points.size()));
+  std::vector<double> along(points.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    const Eigen::Vector3d direction = axes.col(axis);
+    for (size_t k = 0; k < points.size(); ++k) along[k] = direction.dot(points[k].cast<double>());
+    std::nth_element(along.begin(), along.begin() + left_out, along.end());
+    extent.low[axis] = along[left_out];
+    const size_t top = along.size() - 1 - left_out;
+    std::nth_element(along.begin(), along.begin() + top, along.end());
+    extent.high[axis] = along[top];
+  }
+  return extent;
+}
+
 RevolutionMeasures MeasureRevolution(const TriangleMesh& mesh, double slice_mm) {
   IHS_CHECK_ARG(slice_mm > 0, "slice_mm must be positive, got " << slice_mm);
   const std::vector<Face> faces = Faces(mesh);

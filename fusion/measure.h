@@ -64,6 +64,20 @@ struct BoxMeasures {
 /// area-weighted mean of the normals near it). Empty meshes give a share of 0.
 BoxMeasures MeasureBox(const TriangleMesh& mesh, double tolerance_deg = 15.0);
 
+/// Where points lie along three directions: per direction the lowest and the highest
+/// coordinate.
+struct BoxExtent {
+  Eigen::Vector3d low = Eigen::Vector3d::Zero();
+  Eigen::Vector3d high = Eigen::Vector3d::Zero();
+  Eigen::Vector3d Size() const { return high - low; }
+};
+
+/// The extent of `points` along `axes` (orthonormal columns), leaving out `outlier_share` of the
+/// points at each end of each direction (0: all of them, the box that holds every point; a
+/// share in [0, 0.5)). No points: an empty extent at the origin.
+BoxExtent MeasureExtent(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix3d& axes,
+                        double outlier_share = 0.0);
+
 /// How well a scanned surface matches the true one (both in the same frame, mm).
 struct SurfaceComparison {
   /// Mean distance from the scan's surface to the truth's (accuracy), from the truth's to the

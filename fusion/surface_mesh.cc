@@ -109,6 +109,9 @@ void MeshingOptions::Check() const {
   IHS_CHECK_ARG(
       bound_box_min_face_share >= 0 && bound_box_min_face_share <= 1,
       "meshing.bound_box_min_face_share must be in [0, 1], got " << bound_box_min_face_share);
+  IHS_CHECK_ARG(
+      bound_box_outlier_share >= 0 && bound_box_outlier_share <= 0.05,
+      "meshing.bound_box_outlier_share must be in [0, 0.05], got " << bound_box_outlier_share);
 }
 
 TriangleMesh RemoveSmallComponents(const TriangleMesh& mesh, double min_fraction) {
@@ -324,6 +327,7 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
       bound_options.seen_hull = options.bound_by_seen_hull;
       bound_options.revolve_max_residual = options.bound_revolve_max_residual;
       bound_options.box_min_face_share = options.bound_box_min_face_share;
+      bound_options.box_outlier_share = options.bound_box_outlier_share;
       bound_options.min_component_fraction = options.min_component_fraction;
       ClosureBound bound = BoundClosure(result.watertight, result.smoothed,
                                         has_views ? *free_space : FreeSpace(), bound_options);

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -143,6 +144,23 @@ std::vector<DimensionRow> PaperDimensions(const std::string& object_spec,
   } else {
     rows.push_back({"diameter", truth.widest_diameter_mm, captured.widest_diameter_mm});
   }
+  return rows;
+}
+
+bool IsBox(const TriangleMesh& mesh) { return fusion::MeasureBox(mesh).face_share >= 0.9; }
+
+std::vector<DimensionRow> BoxDimensions(const TriangleMesh& truth, const TriangleMesh& scan) {
+  auto sides = [](const TriangleMesh& mesh) {
+    const Eigen::Vector3d size =
+        fusion::MeasureExtent(mesh.vertices, fusion::MeasureBox(mesh).axes).Size();
+    std::array<double, 3> sorted = {size.x(), size.y(), size.z()};
+    std::sort(sorted.begin(), sorted.end(), std::greater<double>());
+    return sorted;
+  };
+  const std::array<double, 3> true_sides = sides(truth), scan_sides = sides(scan);
+  const char* names[3] = {"longest side", "middle side", "shortest side"};
+  std::vector<DimensionRow> rows;
+  for (int k = 0; k < 3; ++k) rows.push_back({names[k], true_sides[k], scan_sides[k]});
   return rows;
 }
 
@@ -332,10 +350,9 @@ fusion::SurfaceComparison CompareWithTruth(const fs::path& gt_dir, const Triangl
 // The paper's dimensions of `object` measured on `mesh`, printed by `print` as a table, as JSON
 // "dimensions" + `suffix` and "dimension_error_mm_mean" + `suffix`.
 template <typename Print>
-nlohmann::json DimensionReport(const std::string& object, const TriangleMesh& mesh,
-                               const std::string& suffix, Print& print) {
+nlohmann::json DimensionReport(const std::vector<DimensionRow>& rows, const std::string& suffix,
+                               Print& print) {
   nlohmann::json report = nlohmann::json::object();
-  const std::vector<DimensionRow> rows = PaperDimensions(object, mesh);
   print("%-16s %10s %10s %10s\n", "measure", "truth mm", "scan mm", "error mm");
   double sum = 0;
   nlohmann::json& table = report["dimensions" + suffix] = nlohmann::json::array();
@@ -457,18 +474,28 @@ nlohmann::json ReportScan(const std::string& object, const TriangleMesh& seen,
     if (out) std::fprintf(out, format, values...);
   };
   nlohmann::json report = nlohmann::json::object();
-  if (!IsBodyOfRevolution(object)) {
-    if (!gt_dir.empty() && watertight.IsWatertight() && fs::exists(gt_dir / "object.ply")) {
-      ReportVolume(ReadMesh(gt_dir / "object.ply").Volume(), watertight, unseen_share, out,
-                   &report);
-    }
-  } else {
-    report.update(DimensionReport(object, seen, "", print));
-    // What the user takes away: the same measures on the closed mesh, where it is another.
+  // The dimensions on the seen surface and, what the user takes away, on the closed mesh where
+  // it is another.
+  auto dimensions = [&](const auto& measure) {
+    report.update(DimensionReport(measure(seen), "", print));
     if (&watertight != &seen && !watertight.faces.empty()) {
       print("on the watertight mesh (mesh.ply):\n");
-      report.update(DimensionReport(object, watertight, "_watertight", print));
+      report.update(DimensionReport(measure(watertight), "_watertight", print));
     }
+  };
+  if (!IsBodyOfRevolution(object)) {
+    if (!gt_dir.empty() && fs::exists(gt_dir / "object.ply")) {
+      const TriangleMesh truth = ReadMesh(gt_dir / "object.ply");
+      // A box's sides (the generator's boxes and cubes).
+      if (IsBox(truth) && !seen.faces.empty()) {
+        dimensions([&](const TriangleMesh& mesh) { return BoxDimensions(truth, mesh); });
+      }
+      if (watertight.IsWatertight()) {
+        ReportVolume(truth.Volume(), watertight, unseen_share, out, &report);
+      }
+    }
+  } else {
+    dimensions([&](const TriangleMesh& mesh) { return PaperDimensions(object, mesh); });
     if (watertight.IsWatertight()) {
       ReportVolume(TrueVolume(object), watertight, unseen_share, out, &report);
     }

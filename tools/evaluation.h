@@ -36,6 +36,16 @@ struct DimensionRow {
 /// captured values measured on `scan`. Throws std::invalid_argument for an unknown object.
 std::vector<DimensionRow> PaperDimensions(const std::string& object_spec, const TriangleMesh& scan);
 
+/// Whether `mesh` is a box: MeasureBox finds at least 90 % of its area facing along three
+/// orthogonal directions (a box's or a cube's true mesh: all of it; a bottle's: a third at most).
+bool IsBox(const TriangleMesh& mesh);
+
+/// A box's sides, longest first ("longest side", "middle side", "shortest side"): the extents of
+/// `truth` (a box, IsBox) along its faces' directions, and of `scan` along the directions its own
+/// faces gather around (fusion::MeasureBox, every vertex counted: what calipers would measure).
+/// Compared by length, longest with longest, so neither needs the other's frame.
+std::vector<DimensionRow> BoxDimensions(const TriangleMesh& truth, const TriangleMesh& scan);
+
 /// The true dimensions of `object_spec`, measured on its densely resampled lathe mesh by the
 /// same code that measures scans.
 fusion::RevolutionMeasures TrueMeasures(const std::string& object_spec);

@@ -299,6 +299,38 @@ TEST(ClosureBoundTest, ABoxSeenFromOneSideKeepsTheCornerBehindIt) {
     ASSERT_LT((turn.transpose() * v).cwiseAbs().maxCoeff(), 21.0f);
 }
 
+TEST(ClosureBoundTest, ABlobProudOfABoxsFaceIsCutBackToTheFace) {
+  // A 40 mm cube seen all round, with a 3 x 3 vertex blob 5 mm proud of its +x face (a piece of
+  // the hand fused with it), inside a ball as Poisson's guess. The box that holds every seen
+  // vertex holds the blob; leaving out half a percent of them beyond each face, it ends at the
+  // face.
+  TriangleMesh seen = GridBox(40, 20);
+  const auto first = static_cast<std::int32_t>(seen.vertices.size());
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) seen.vertices.emplace_back(25.0f, 2.0f * i, 2.0f * j);
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      const std::int32_t a = first + 3 * j + i;
+      seen.faces.push_back({a, a + 1, a + 3});
+      seen.faces.push_back({a + 1, a + 4, a + 3});
+    }
+  }
+  const TriangleMesh ball = test::MakeUvSphere(55, 32, 64);
+  ClosureBoundOptions all;
+  all.box_outlier_share = 0;
+  const ClosureBound every = BoundClosure(ball, seen, FreeSpace(), all);
+  const ClosureBound face = BoundClosure(ball, seen, FreeSpace(), {});  // Half a percent.
+  EXPECT_EQ(ClosureBoundOptions().box_outlier_share, 0.005);
+  ASSERT_TRUE(every.changed && face.changed);
+  EXPECT_EQ(face.hull_shape, HullShape::kBox);
+  float every_x = -INFINITY, face_x = -INFINITY;
+  for (const auto& v : every.mesh.vertices) every_x = std::max(every_x, v.x());
+  for (const auto& v : face.mesh.vertices) face_x = std::max(face_x, v.x());
+  EXPECT_GT(every_x, 24.0f);
+  EXPECT_LT(face_x, 21.0f);
+  EXPECT_NEAR(face.mesh.Volume(), 40.0 * 40 * 40, 0.04 * 40 * 40 * 40);
+}
+
 TEST(ClosureBoundTest, AConcaveSeenSurfaceIsInsideItsHullAndStays) {
   // A bowling pin's neck, seen all round: 30 mm wide at the ends, 18 mm at the waist. The
   // closure over its unseen ends bulges and is cut; the neck, inside the hull, is not.

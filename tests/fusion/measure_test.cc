@@ -10,9 +10,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "tests/mesh_fixtures.h"
+#include "tests/test_util.h"
 #include "tools/synth/objects.h"
 
 namespace ihs::fusion {
@@ -169,6 +172,33 @@ TEST(MeasureTest, ABoxFacesAlongThreeDirectionsARoundObjectDoesNot) {
     EXPECT_LT(MeasureBox(PaperObject(name)).face_share, 0.5) << name;
   }
   EXPECT_EQ(MeasureBox(TriangleMesh{}).face_share, 0);
+}
+
+TEST(MeasureTest, AnExtentHoldsThePointsOrAllButItsOutliers) {
+  // 1000 points in a turned 60 x 45 x 90 mm box, and three 6 mm proud of its +y face (a blob):
+  // every point's extent takes them in; leaving out 0.5 % at each end cuts them off.
+  std::mt19937 rng = test::Rng();
+  std::uniform_real_distribution<float> unit(-0.5f, 0.5f);
+  const Eigen::Matrix3d axes =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(2, 1, -1).normalized()).toRotationMatrix();
+  std::vector<Eigen::Vector3f> points;
+  for (int k = 0; k < 1000; ++k) {
+    const Eigen::Vector3d local(60 * unit(rng), 45 * unit(rng), 90 * unit(rng));
+    points.push_back((axes * local).cast<float>());
+  }
+  for (int k = 0; k < 3; ++k)
+    points.push_back((axes * Eigen::Vector3d(k, 22.5 + 6, 10 * k)).cast<float>());
+  const BoxExtent all = MeasureExtent(points, axes);
+  const BoxExtent kept = MeasureExtent(points, axes, 0.005);
+  EXPECT_NEAR(all.high.y(), 28.5, 1e-4);
+  EXPECT_LT(kept.high.y(), 22.5 + 1e-4);
+  EXPECT_GT(kept.high.y(), 22.0);  // Five points of 1003 off the face: about 0.2 mm.
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LE(all.low[axis], kept.low[axis]);
+    EXPECT_NEAR(kept.Size()[axis], Eigen::Vector3d(60, 45, 90)[axis], 1.5) << axis;
+  }
+  EXPECT_EQ(MeasureExtent({}, axes).Size(), Eigen::Vector3d::Zero());
+  EXPECT_THROW(MeasureExtent(points, axes, 0.5), std::invalid_argument);
 }
 
 TEST(MeasureTest, SurfaceComparisonMeasuresTheGapAndTheCoverage) {

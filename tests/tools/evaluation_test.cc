@@ -18,6 +18,7 @@
 #include "core/errors.h"
 #include "core/mesh_io.h"
 #include "sensor/tum_directory.h"
+#include "tests/mesh_fixtures.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
 #include "tracker/hand_joints_io.h"
@@ -296,6 +297,43 @@ TEST_F(EvaluationTest, AnObjectWithoutThePapersMeasuresGetsItsVolumeFromTheTruth
     ASSERT_TRUE(report.contains("volume_error")) << name;
     EXPECT_NEAR(report["volume_error"].get<double>(), 0.331, 0.002) << name;
   }
+}
+
+TEST_F(EvaluationTest, ABoxsSidesAreMeasuredOnTheSeenSurfaceAndOnTheClosedMesh) {
+  // A 90 × 60 × 45 mm box turned off the axes; scans of it 2.5 mm too wide across its shortest
+  // side (the seen surface) and 4 mm (the closed mesh). Its sides are found along its own faces,
+  // longest to shortest, and compared with the truth's in that order, on both meshes.
+  const Eigen::Matrix3f turn =
+      Eigen::AngleAxisf(0.6f, Eigen::Vector3f(1, -2, 0.7).normalized()).toRotationMatrix();
+  auto box = [&](float x, float y, float z) {
+    TriangleMesh mesh = test::MakeCube(1.0f);
+    for (auto& v : mesh.vertices) v = turn * Eigen::Vector3f(v.x() * x, v.y() * y, v.z() * z);
+    return mesh;
+  };
+  const TriangleMesh truth = box(60, 90, 45), seen = box(60, 90, 47.5), closed = box(60, 90, 49);
+  EXPECT_TRUE(IsBox(truth));
+  EXPECT_FALSE(IsBox(test::MakeUvSphere(30, 16, 32)));
+  const std::vector<DimensionRow> rows = BoxDimensions(truth, seen);
+  ASSERT_EQ(rows.size(), 3u);
+  const std::array<double, 3> true_sides = {90, 60, 45}, scan_sides = {90, 60, 47.5};
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(rows[k].truth_mm, true_sides[k], 1e-3) << rows[k].measure;
+    EXPECT_NEAR(rows[k].captured_mm, scan_sides[k], 1e-3) << rows[k].measure;
+  }
+  EXPECT_EQ(rows[2].measure, "shortest side");
+
+  // Through the report, the truth's box in a gt/ folder of its own: the seen surface's sides
+  // and mesh.ply's, whatever the object is called.
+  test::TempDir dir;
+  std::filesystem::copy(Gt(), dir.path() / "gt", std::filesystem::copy_options::recursive);
+  WriteMesh(dir.path() / "gt" / "object.ply", truth);
+  const auto trajectory = ReadTumTrajectory(Gt() / "trajectory.txt");
+  const nlohmann::json report =
+      ReportScan("plain-box", seen, closed, dir.path() / "gt", trajectory, std::nullopt, nullptr);
+  ASSERT_TRUE(report.contains("dimensions") && report.contains("dimensions_watertight"));
+  EXPECT_NEAR(report["dimensions"][2]["scan_mm"].get<double>(), 47.5, 1e-3);
+  EXPECT_NEAR(report["dimensions_watertight"][2]["scan_mm"].get<double>(), 49.0, 1e-3);
+  EXPECT_NEAR(report["dimension_error_mm_mean_watertight"].get<double>(), 4.0 / 3, 1e-3);
 }
 
 }  // namespace
