@@ -138,6 +138,12 @@ void AddGraspSideOptions(OptionRegistry& r, tracker::GraspSideOptions* side) {
         "object points within this distance of the hand points' centroid make the held object, mm");
   r.Add("tracker.grasp_side.min_object_points", &g.min_object_points,
         "fewer object points near the hand: no object seen, no penalty");
+  r.Add("tracker.grasp_side.opposition_weight", &g.opposition_weight,
+        "score penalty per unit of cosine beyond max_opposition_cosine between the thumb's tip and "
+        "the fingertips seen from the held object's middle (0: off)");
+  r.Add("tracker.grasp_side.max_opposition_cosine", &g.max_opposition_cosine,
+        "cosine between the thumb's tip and the fingertips, from the object's middle, above which "
+        "a pose is penalised (-1: straight across)");
 }
 
 // The fusion's sub-groups: the TSDF volume, and the registration (pairwise and ICP).
@@ -286,6 +292,8 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
         "frames between fits of the hand turned over (palm for back) beside the fit (0: never)");
   r.Add("tracker.flip_tie_score", &t.flip_tie_score,
         "fit scores this close make the turned-over fit a tie and the pose doubtful");
+  r.Add("tracker.thumb_check", &t.thumb_check,
+        "with each turned-over check, also fit the thumb started in other places");
   AddSegmentationOptions(r, &t.segmentation);
   AddHandFitOptions(r, &t.fit);
   AddContactOptions(r, &t.contacts);

@@ -14,6 +14,9 @@ void GraspSideOptions::Check() const {
                 "tracker.grasp_side.min_cosine must be in [-1, 1]");
   IHS_CHECK_ARG(near_hand_mm > 0, "tracker.grasp_side.near_hand_mm must be positive");
   IHS_CHECK_ARG(min_object_points >= 1, "tracker.grasp_side.min_object_points must be >= 1");
+  IHS_CHECK_ARG(opposition_weight >= 0, "tracker.grasp_side.opposition_weight must be >= 0");
+  IHS_CHECK_ARG(max_opposition_cosine >= -1 && max_opposition_cosine <= 1,
+                "tracker.grasp_side.max_opposition_cosine must be in [-1, 1]");
 }
 
 std::optional<GraspSide> GraspSide::Of(const Segmentation& segmentation,
@@ -53,9 +56,27 @@ double GraspSide::Penalty(const PalmAxes& palm, bool right_hand) const {
   return options_.weight * std::max(0.0, options_.min_cosine - Cosine(palm, right_hand));
 }
 
+double GraspSide::Opposition(const HandModel& model,
+                             const std::vector<Eigen::Vector3d>& joints) const {
+  Eigen::Vector3d thumb = Eigen::Vector3d::Zero(), fingers = Eigen::Vector3d::Zero();
+  int thumbs = 0, tips = 0;
+  for (int end : model.EndEffectors()) {
+    const Eigen::Vector3d tip = joints[static_cast<size_t>(end) + 1] - centre_;
+    if (model.FingerOf(end) == 4) {
+      thumb += tip, ++thumbs;
+    } else {
+      fingers += tip, ++tips;
+    }
+  }
+  const double length = thumb.norm() * fingers.norm();
+  return thumbs > 0 && tips > 0 && length > 0 ? thumb.dot(fingers) / length : 1.0;
+}
+
 double GraspSide::Penalty(const HandModel& model, const HandPose& pose, bool right_hand) const {
-  return Penalty(PalmAxesOf(model, model.JointPositions(ForwardKinematics(model, pose))),
-                 right_hand);
+  const std::vector<Eigen::Vector3d> joints = model.JointPositions(ForwardKinematics(model, pose));
+  return Penalty(PalmAxesOf(model, joints), right_hand) +
+         options_.opposition_weight *
+             std::max(0.0, Opposition(model, joints) - options_.max_opposition_cosine);
 }
 
 }  // namespace ihs::tracker

@@ -7,7 +7,10 @@
 // tools/bench_hand_init.sh every true pose has its palm toward the object, cosine 0.53–0.89
 // between its normal and the direction to the object's middle, while the wrong fits kept
 // there lay at −0.67–0.98). GraspSide turns that into a penalty in the tracker's scores: a pose
-// whose palm faces away from the object seen in its hand explains the frame worse.
+// whose palm faces away from the object seen in its hand explains the frame worse. So does one
+// whose thumb is not across the object from its fingers: a hand holds what it holds between
+// them, and a thumb hidden behind the object, which depth does not show, slides to the fingers'
+// side (docs/tracker.md).
 
 #include <Eigen/Core>
 #include <optional>
@@ -31,6 +34,11 @@ struct GraspSideOptions {
   double near_hand_mm = 120.0;
   /// Fewer object points than this near the hand: no object seen, no prior.
   int min_object_points = 100;
+  /// Penalty per unit of cosine above max_opposition_cosine between the directions from the
+  /// object's middle to the thumb's tip and to the fingertips' centroid (a hand holding
+  /// something holds it between its thumb and its fingers: −1 straight across).
+  double opposition_weight = 10.0;
+  double max_opposition_cosine = 0.2;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -56,7 +64,12 @@ class GraspSide {
   /// The penalty of a palm so placed: weight × how far its cosine lies below min_cosine.
   double Penalty(const PalmAxes& palm, bool right_hand) const;
 
-  /// Penalty of `pose` of `model` (its palm's axes from its joints).
+  /// The cosine between the directions from the object's middle to the thumb's tip and to the
+  /// other fingertips' centroid, of `joints` (HandModel::JointPositions) of `model`; 1 for a
+  /// model without a thumb.
+  double Opposition(const HandModel& model, const std::vector<Eigen::Vector3d>& joints) const;
+
+  /// Penalty of `pose` of `model`: its palm's (from its joints) and its thumb's opposition.
   double Penalty(const HandModel& model, const HandPose& pose, bool right_hand) const;
 
  private:

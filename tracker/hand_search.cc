@@ -230,6 +230,37 @@ HandPose TurnedOver(const HandModel& model, const HandPose& pose) {
   return out;
 }
 
+std::vector<HandPose> ThumbVariants(const HandModel& model, const HandPose& pose) {
+  const std::vector<DegreeOfFreedom> dofs = JointDegreesOfFreedom(model);
+  // The thumb's first bone with active axes: its metacarpal.
+  int bone = -1;
+  for (const DegreeOfFreedom& dof : dofs) {
+    if (model.FingerOf(dof.bone) == 4) {
+      bone = dof.bone;
+      break;
+    }
+  }
+  std::vector<size_t> indices;
+  for (size_t k = 0; k < dofs.size(); ++k)
+    if (dofs[k].bone == bone) indices.push_back(k);
+  std::vector<HandPose> variants;
+  if (indices.empty()) return variants;
+  size_t combinations = 1;
+  for (size_t k = 0; k < indices.size(); ++k) combinations *= 3;
+  for (size_t c = 0; c < combinations; ++c) {
+    HandPose variant = pose;
+    size_t code = c;
+    for (size_t index : indices) {
+      const auto [low, high] = model.limits[bone].limits_deg[dofs[index].axis];
+      const double fraction = (1.0 + 2.0 * static_cast<double>(code % 3)) / 6.0;
+      code /= 3;
+      variant.angles_rad[index] = (low + fraction * (high - low)) * M_PI / 180.0;
+    }
+    variants.push_back(std::move(variant));
+  }
+  return variants;
+}
+
 std::vector<Rigid3> GraspStarts(const PalmAxes& palm, bool right_hand,
                                 const Eigen::Vector3d& object, const Eigen::Vector3d& hand,
                                 const HandSearchOptions& options) {

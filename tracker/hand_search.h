@@ -86,6 +86,13 @@ HandPose CurledHand(const HandModel& model, double fraction);
 /// articulation is kept. The ambiguity a depth fit can tie on (docs/tracker.md).
 HandPose TurnedOver(const HandModel& model, const HandPose& pose);
 
+/// `pose` with the thumb's first joint (the metacarpal's, every active axis) set to each of a
+/// few angles across its range (a sixth of the range in from each limit, and the middle): the
+/// thumb's placements a fit from another one does not reach (it opposes the fingers round a held
+/// object, lies along the index, or crosses the palm). The pose itself is not among them; none
+/// where the model has no thumb.
+std::vector<HandPose> ThumbVariants(const HandModel& model, const HandPose& pose);
+
 /// Rigid starts (cam_from_root) for an articulation whose palm (in its root's frame) is `palm`
 /// that hold an object in the palm: the palm's normal (toward the palm, `right_hand` the
 /// model's side) points at `object` (the held object's middle) from the side of `hand` (the hand

@@ -332,6 +332,38 @@ bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_point
   return std::abs(other - kept) < options_.flip_tie_score;
 }
 
+void HandTracker::CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
+                             TrackResult& result, const GraspSide* side) const {
+  // Only a thumb that does not hold the object against the fingers is tried elsewhere.
+  if (side == nullptr ||
+      side->Opposition(model_, model_.JointPositions(ForwardKinematics(model_, result.fit.pose))) <=
+          options_.grasp_side.max_opposition_cosine) {
+    return;
+  }
+  // Every variant fitted briefly (on the search's threads), the best of them fitted on.
+  const std::vector<HandPose> variants = ThumbVariants(model_, result.fit.pose);
+  if (variants.empty()) return;
+  std::vector<HandFitResult> fits(variants.size());
+  std::vector<double> scores(variants.size());
+  ParallelRuns(variants.size(), options_.search.threads, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      fits[k] = coarse_fitter_->Fit(hand_points, &frame, variants[k], &result.segmentation);
+      scores[k] = Score(fits[k], side);
+    }
+  });
+  const size_t best =
+      static_cast<size_t>(std::min_element(scores.begin(), scores.end()) - scores.begin());
+  HandFitResult refined =
+      initial_fitter_->Fit(hand_points, &frame, fits[best].pose, &result.segmentation);
+  const double kept = Score(result.fit, side), other = Score(refined, side);
+  spdlog::debug("frame {}: fit scores {:.2f}, the thumb elsewhere {:.2f}", frame.index, kept,
+                other);
+  if (other < kept) {
+    result.fit = std::move(refined);
+    if (result.status == TrackStatus::kTracked) result.status = TrackStatus::kInitialised;
+  }
+}
+
 TrackResult HandTracker::Track(const Frame& frame) {
   const auto started = SteadyClock::now();
   TrackResult result;
@@ -411,6 +443,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
        ++frames_since_flip_check_ >= options_.flip_check_frames)) {
     frames_since_flip_check_ = 0;
     tie = CheckTurnedOver(points, frame, result, side());
+    if (options_.thumb_check) CheckThumb(points, frame, result, side());
   }
   if (result.fit.data_coverage >= options_.search_data_coverage && !tie) {
     confident_pose_ = result.fit.pose;

@@ -79,6 +79,13 @@ struct TrackerOptions {
   /// guards against the held-out palm-for-back fit.
   int flip_check_frames = 10;
   double flip_tie_score = 0.5;
+  /// With each turned-over check, where an object is seen in the hand and the fit's thumb does
+  /// not hold it against the fingers (GraspSide::Opposition above max_opposition_cosine), the
+  /// thumb is also started elsewhere (ThumbVariants), each fitted for search_coarse_iterations,
+  /// the best for initialisation_iterations; it replaces the fit when it scores better. A thumb
+  /// hidden behind the object slid to the fingers' side in half the flipped sequences of
+  /// tools/bench_hand_init.sh (docs/tracker.md).
+  bool thumb_check = true;
   /// A search that a run of doubtful fits starts runs beside the tracking instead of stalling
   /// it: the tracker goes on fitting each frame from its last pose, and once the search is done
   /// its best pose (found on an older frame, moved on by the tracked root's motion since) is
@@ -213,6 +220,10 @@ class HandTracker {
   // better; returns whether the two tie (within flip_tie_score).
   bool CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
                        TrackResult& result, const GraspSide* side) const;
+  // The fit with its thumb started elsewhere (ThumbVariants), fitted: the best replaces
+  // `result`'s fit when it explains the hand better.
+  void CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
+                  TrackResult& result, const GraspSide* side) const;
   // Builds the fitters and the contact detector for model_.
   void BuildStages();
   // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's

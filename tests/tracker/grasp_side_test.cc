@@ -68,6 +68,11 @@ TEST(GraspSideTest, AHeldObjectLiesOnThePalmsSideOfTheTruePoseNotOfItsTurnedOver
     const HandPose truth = PoseFromBoneTransforms(hand, rendered.cam_from_bone);
     const PalmAxes palm = PalmAxesOf(hand, hand.JointPositions(ForwardKinematics(hand, truth)));
     EXPECT_GT(side->Cosine(palm, right), 0.3);
+    // The thumb holds the object against the fingers: across its middle from them (seen from
+    // the middle estimated from the part by the hand: −0.99 … +0.05; the tall bottle's lies
+    // below the hand).
+    EXPECT_LT(side->Opposition(hand, hand.JointPositions(ForwardKinematics(hand, truth))),
+              GraspSideOptions().max_opposition_cosine);
     EXPECT_EQ(side->Penalty(hand, truth, right), 0.0);
     // Turned over, the palm faces away: penalised by at least the weight times the margin.
     EXPECT_GT(side->Penalty(hand, TurnedOver(hand, truth), right),

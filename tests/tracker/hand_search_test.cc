@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <set>
+#include <vector>
 
 #include "tools/synth/sequence.h"
 #include "tracker/hand_fit.h"
@@ -240,6 +242,36 @@ TEST(HandSearchTest, GraspStartsHoldTheObjectInThePalm) {
   }
   options.grasp_rolls = -1;
   EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
+TEST(HandSearchTest, ThumbVariantsMoveOnlyTheThumbsFirstJointAcrossItsRange) {
+  const HandModel model = MakeProceduralHand();
+  const HandPose pose = CurledHand(model, 0.4);
+  const std::vector<HandPose> variants = ThumbVariants(model, pose);
+  const std::vector<DegreeOfFreedom> dofs = JointDegreesOfFreedom(model);
+  int thumb_base = -1;  // The thumb's first bone with angles: three of them on this template.
+  for (const DegreeOfFreedom& dof : dofs)
+    if (thumb_base < 0 && model.FingerOf(dof.bone) == 4) thumb_base = dof.bone;
+  ASSERT_GE(thumb_base, 0);
+  ASSERT_EQ(variants.size(), 27u);
+  std::set<std::vector<double>> distinct;
+  for (const HandPose& variant : variants) {
+    std::vector<double> thumb;
+    for (size_t k = 0; k < dofs.size(); ++k) {
+      if (dofs[k].bone != thumb_base) {
+        EXPECT_EQ(variant.angles_rad[k], pose.angles_rad[k]);
+        continue;
+      }
+      const auto [low, high] = model.limits[thumb_base].limits_deg[dofs[k].axis];
+      const double deg = variant.angles_rad[k] * 180 / M_PI;
+      EXPECT_GT(deg, low);
+      EXPECT_LT(deg, high);
+      thumb.push_back(deg);
+    }
+    distinct.insert(thumb);
+    EXPECT_TRUE(variant.cam_from_root.translation().isApprox(pose.cam_from_root.translation()));
+  }
+  EXPECT_EQ(distinct.size(), 27u);
 }
 
 TEST(HandSearchTest, NoPointsGiveNoHypotheses) {
