@@ -58,7 +58,7 @@ struct MeshingOptions {
   double bound_box_min_face_share = 0.8;
   /// The box leaves out this share of the seen surface's vertices beyond each of its six faces
   /// (ClosureBoundOptions::box_outlier_share): a blob of the hand fused proud of a face is cut
-  /// back to the face. On 14 fifth turns of boxes and cubes every side of mesh.ply came closer to
+  /// back to the face. On 12 fifth turns of boxes and cubes every side of mesh.ply came closer to
   /// the truth's, 1-4 mm (docs/fusion.md); 0: the box holds every seen vertex.
   double bound_box_outlier_share = 0.005;
   /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).

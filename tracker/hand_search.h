@@ -89,8 +89,8 @@ HandPose TurnedOver(const HandModel& model, const HandPose& pose);
 /// `pose` with the thumb's first joint (the metacarpal's, every active axis) set to each of a
 /// few angles across its range (a sixth of the range in from each limit, and the middle): the
 /// thumb's placements a fit from another one does not reach (it opposes the fingers round a held
-/// object, lies along the index, or crosses the palm). The pose itself is not among them; none
-/// where the model has no thumb.
+/// object, lies along the index, or crosses the palm): 3^n of them for n active axes (27 on
+/// the procedural template), the rest of the pose kept; none where the model has no thumb.
 std::vector<HandPose> ThumbVariants(const HandModel& model, const HandPose& pose);
 
 /// Rigid starts (cam_from_root) for an articulation whose palm (in its root's frame) is `palm`
