@@ -12,6 +12,7 @@
 #include <map>
 #include <mutex>
 #include <numeric>
+#include <thread>
 #include <vector>
 
 #include "core/check.h"
@@ -99,6 +100,9 @@ void MeshingOptions::Check() const {
   IHS_CHECK_ARG(poisson_scale >= 1 && poisson_scale <= 4,
                 "meshing.poisson_scale must be in [1, 4] (below 1 the cube cuts the surface), got "
                     << poisson_scale);
+  IHS_CHECK_ARG(
+      poisson_threads >= 0 && poisson_threads <= 256,
+      "meshing.poisson_threads must be in [0, 256] (0: one per core), got " << poisson_threads);
   IHS_CHECK_ARG(bound_voxel_mm >= 0.25 && bound_voxel_mm <= 20,
                 "meshing.bound_voxel_mm must be in [0.25, 20], got " << bound_voxel_mm);
   IHS_CHECK_ARG(bound_keep_seen_mm >= 0 && bound_keep_seen_mm <= 50,
@@ -232,8 +236,32 @@ int FillHoles(TriangleMesh* mesh) {
   return holes;
 }
 
+namespace {
+
+#if defined(__SANITIZE_THREAD__)
+constexpr bool kThreadSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+constexpr bool kThreadSanitizer = true;
+#else
+constexpr bool kThreadSanitizer = false;
+#endif
+#else
+constexpr bool kThreadSanitizer = false;
+#endif
+
+// The threads Poisson's solve gets for `requested` (0: one per core); 1 under ThreadSanitizer,
+// which cannot see libgomp's synchronisation.
+int PoissonThreads(int requested) {
+  if (kThreadSanitizer) return 1;
+  if (requested > 0) return requested;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+}  // namespace
+
 TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
-                                double scale, bool color) {
+                                double scale, bool color, int threads) {
   constexpr size_t kMinPoints = 16;
   if (mesh.vertices.size() < kMinPoints) return {};
   TriangleMesh oriented = mesh;
@@ -256,6 +284,7 @@ TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samp
   poisson.setSamplesPerNode(static_cast<float>(samples_per_node));
   poisson.setManifold(true);
   poisson.setScale(static_cast<float>(scale));
+  poisson.setThreads(PoissonThreads(threads));
   poisson.setOutputPolygons(false);
   poisson.setInputCloud(cloud);
   pcl::PointCloud<pcl::PointNormal> points;
@@ -315,7 +344,7 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
     // Poisson may close off stray bubbles beside the surface: they go like small pieces do.
     result.watertight = RemoveSmallComponents(
         PoissonReconstruct(result.smoothed, options.poisson_depth, options.poisson_samples_per_node,
-                           options.poisson_scale, options.color),
+                           options.poisson_scale, options.color, options.poisson_threads),
         options.min_component_fraction);
     result.poisson_ms = MillisecondsSince(start);
     const bool has_views = free_space != nullptr && free_space->views() > 0;

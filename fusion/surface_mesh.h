@@ -34,6 +34,11 @@ struct MeshingOptions {
   /// implicit surface to close over what was never seen (under the fingers) inside the cube
   /// rather than running into its faces.
   double poisson_scale = 1.5;
+  /// Threads of Poisson's octree solve (PCL's OpenMP; 0: one per core). The solve is most of
+  /// the export (1.7-2.6 s of 2.0-3.0 s on the paper's whole sessions on one thread), and at
+  /// the end of a scan the other threads are idle. A build under ThreadSanitizer uses 1 whatever
+  /// this says: libgomp is not instrumented, and its threads' work would be reported as races.
+  int poisson_threads = 0;
   /// The closed mesh is cut back to the space no view saw empty (closure_bound.h), remeshed on
   /// a lattice of this step (mm; about the TSDF's 1.37 mm voxel, finer than Poisson's detail
   /// on a hand-held object); within `bound_keep_seen_mm` of the seen surface nothing is cut.
@@ -87,9 +92,10 @@ int FillHoles(TriangleMesh* mesh);
 /// outward; colours come from the nearest input vertex when `color` and the input has them.
 /// PCL's extraction now and then drops a triangle whose edge it cannot match (printing "Vertex
 /// pair not in list" to stdout, which is kept out of ours): the small holes left are filled.
-/// Returns an empty mesh when `mesh` has too few vertices to reconstruct from.
+/// Returns an empty mesh when `mesh` has too few vertices to reconstruct from. `threads` as
+/// MeshingOptions::poisson_threads.
 TriangleMesh PoissonReconstruct(const TriangleMesh& mesh, int depth, double samples_per_node,
-                                double scale, bool color);
+                                double scale, bool color, int threads = 1);
 
 /// The exported meshes of one raw marching-cubes mesh.
 struct MeshingResult {

@@ -211,6 +211,7 @@ TEST(OptionRegistryTest, ValuesThatWouldExhaustMemoryOrTimeAreRefused) {
       {"mesh.poisson_scale", "-1"},
       {"mesh.poisson_scale", "0.5"},
       {"mesh.poisson_depth", "20"},
+      {"mesh.poisson_threads", "100000"},
   };
   for (const auto& [name, value] : cases) {
     ScannerOptions options;
