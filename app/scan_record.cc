@@ -42,6 +42,7 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (!track.reason.empty()) entry["track_reason"] = track.reason;
     if (track.doubtful) entry["track_doubtful"] = true, ++doubtful_frames_;
     if (track.turned_over) entry["track_turned_over"] = true, ++turned_over_frames_;
+    if (track.thumb_moved) entry["track_thumb_moved"] = true, ++thumb_moved_frames_;
     timing("track_ms", track.milliseconds);
     timing("segmentation_ms", track.segmentation_ms);
     timing("hand_fit_ms", track.fit_ms);
@@ -161,6 +162,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"track_status_counts", track_counts_},
                             {"hand_doubtful_frames", doubtful_frames_},
                             {"hand_turned_over_frames", turned_over_frames_},
+                            {"hand_thumb_moved_frames", thumb_moved_frames_},
                             {"held_grasp_frames", held_grasp_frames_},
                             {"icp_slid_frames", icp_slid_frames_},
                             {"keyframes", keyframes_},

@@ -36,8 +36,10 @@ struct GraspSideOptions {
   int min_object_points = 100;
   /// Penalty per unit of cosine above max_opposition_cosine between the directions from the
   /// object's middle to the thumb's tip and to the fingertips' centroid (a hand holding
-  /// something holds it between its thumb and its fingers: −1 straight across).
-  double opposition_weight = 10.0;
+  /// something holds it between its thumb and its fingers: −1 straight across). Off (0) by
+  /// default, with TrackerOptions::thumb_check: at 10 the hand's fits flip less, but the scans
+  /// of 22 full turns followed less of them (docs/tracker.md).
+  double opposition_weight = 0.0;
   double max_opposition_cosine = 0.2;
 
   /// Throws std::invalid_argument naming the bad field.

@@ -147,6 +147,14 @@ void HandTracker::BuildStages() {
   contacts_ = std::make_unique<ContactDetector>(model_, options_.contacts);
   grasp_hold_ = std::make_unique<GraspHold>(options_.grasp_hold, options_.contacts.min_bones,
                                             model_.EndEffectors(), contacts_->fingertip_vertices());
+  thumb_vertices_.clear();
+  const std::vector<int> ends = model_.EndEffectors();
+  for (size_t k = 0; k < ends.size() && k < contacts_->fingertip_vertices().size(); ++k) {
+    if (model_.FingerOf(ends[k]) != 4) continue;
+    const std::vector<int>& tip = contacts_->fingertip_vertices()[k];
+    thumb_vertices_.insert(thumb_vertices_.end(), tip.begin(), tip.end());
+  }
+  std::sort(thumb_vertices_.begin(), thumb_vertices_.end());
 }
 
 HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) const {
@@ -332,17 +340,17 @@ bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_point
   return std::abs(other - kept) < options_.flip_tie_score;
 }
 
-void HandTracker::CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
+bool HandTracker::CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
                              TrackResult& result, const GraspSide* side) const {
   // Only a thumb that does not hold the object against the fingers is tried elsewhere.
   if (side == nullptr ||
       side->Opposition(model_, model_.JointPositions(ForwardKinematics(model_, result.fit.pose))) <=
           options_.grasp_side.max_opposition_cosine) {
-    return;
+    return false;
   }
   // Every variant fitted briefly (on the search's threads), the best of them fitted on.
   const std::vector<HandPose> variants = ThumbVariants(model_, result.fit.pose);
-  if (variants.empty()) return;
+  if (variants.empty()) return false;
   std::vector<HandFitResult> fits(variants.size());
   std::vector<double> scores(variants.size());
   ParallelRuns(variants.size(), options_.search.threads, [&](size_t begin, size_t end) {
@@ -360,8 +368,9 @@ void HandTracker::CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, co
                 other);
   if (other < kept) {
     result.fit = std::move(refined);
-    if (result.status == TrackStatus::kTracked) result.status = TrackStatus::kInitialised;
+    return true;
   }
+  return false;
 }
 
 TrackResult HandTracker::Track(const Frame& frame) {
@@ -438,12 +447,14 @@ TrackResult HandTracker::Track(const Frame& frame) {
   }
   // Palm for back: the fit turned over, now and then, and always on a fit found from scratch.
   bool& tie = result.flip_tie;
+  // The thumb check moved the thumb alone: the rest of the hand is the previous one moved.
+  bool& thumb_moved = result.thumb_moved;
   if (options_.flip_check_frames > 0 && result.fit.data_coverage >= options_.min_data_coverage &&
       (result.status == TrackStatus::kInitialised ||
        ++frames_since_flip_check_ >= options_.flip_check_frames)) {
     frames_since_flip_check_ = 0;
     tie = CheckTurnedOver(points, frame, result, side());
-    if (options_.thumb_check) CheckThumb(points, frame, result, side());
+    thumb_moved = options_.thumb_check && CheckThumb(points, frame, result, side());
   }
   if (result.fit.data_coverage >= options_.search_data_coverage && !tie) {
     confident_pose_ = result.fit.pose;
@@ -493,9 +504,12 @@ TrackResult HandTracker::Track(const Frame& frame) {
     const PointKdTree object(std::move(near));
     result.contacts = grasp_hold_->Update(contacts_->Detect(vertices, object), vertices,
                                           pose_.cam_from_root, object);
-    // A pose found anew (a search) is not the previous one moved: no pairs across it.
+    // A pose found anew (a search) is not the previous one moved: no pairs across it; nor
+    // across a thumb the thumb check moved.
     if (!previous_vertices_.empty() && result.status == TrackStatus::kTracked) {
       for (int v : result.contacts.vertices) {
+        if (thumb_moved && std::binary_search(thumb_vertices_.begin(), thumb_vertices_.end(), v))
+          continue;
         if (std::binary_search(previous_contact_vertices_.begin(), previous_contact_vertices_.end(),
                                v)) {
           result.contact_pairs.push_back(

@@ -47,7 +47,10 @@ TEST(GraspSideTest, AHeldObjectLiesOnThePalmsSideOfTheTruePoseNotOfItsTurnedOver
     const synth::RenderedFrame rendered = renderer.Render(4);
     const Segmentation segmentation =
         Segmenter(renderer.options().intrinsics, SegmentationOptions()).Segment(rendered.frame);
-    const std::optional<GraspSide> side = GraspSide::Of(segmentation, GraspSideOptions());
+    // The thumb's opposition counted too (off by default): a true grasp is not penalised.
+    GraspSideOptions with_thumb;
+    with_thumb.opposition_weight = 10;
+    const std::optional<GraspSide> side = GraspSide::Of(segmentation, with_thumb);
     ASSERT_TRUE(side.has_value());
 
     // The estimated middle (of the part by the hand) lies within a quarter of the object's
