@@ -66,6 +66,7 @@ class ScanRecord {
   std::int64_t doubtful_frames_ = 0;  // Frames whose hand pose was doubtful.
   // Frames where the fit turned over (palm for back) replaced the tracked one.
   std::int64_t turned_over_frames_ = 0;
+  // Frames whose thumb the thumb check moved (tracker::TrackerOptions::thumb_check).
   std::int64_t thumb_moved_frames_ = 0;
   // Frames whose contacts were a grasp held without being detected (tracker::GraspHold).
   std::int64_t held_grasp_frames_ = 0;

@@ -84,8 +84,8 @@ struct TrackerOptions {
   /// thumb is also started elsewhere (ThumbVariants), each fitted for search_coarse_iterations,
   /// the best for initialisation_iterations; it replaces the fit when it scores better. A thumb
   /// hidden behind the object slid to the fingers' side in half the flipped sequences of
-  /// tools/bench_hand_init.sh (docs/tracker.md). The frame stays tracked (TrackResult::
-  /// thumb_moved): the hand's motion across it still carries a held object's turn. Off by
+  /// tools/bench_hand_init.sh (docs/tracker.md). A frame whose thumb it moved stays tracked
+  /// (TrackResult::thumb_moved): the hand's motion across it still carries a held object. Off by
   /// default: with it (and GraspSideOptions::opposition_weight 10) fewer fits flipped on the 72
   /// generated grasps (33 → 17), but on 22 scripted full turns the scans followed 81 → 76 % of
   /// the turn, used contacts in 56 → 48 % of the grasping frames, Chamfer 1.73 → 2.19 mm.
