@@ -398,7 +398,9 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
   r.Add("mesh.poisson_samples_per_node", &m.poisson_samples_per_node,
         "Poisson minimum samples per octree node");
   r.Add("mesh.poisson_scale", &m.poisson_scale, "Poisson cube edge over the points' bounding box");
-  r.Add("mesh.poisson_threads", &m.poisson_threads, "threads of Poisson's solve (0: one per core)");
+  r.Add("mesh.poisson_threads", &m.poisson_threads,
+        "threads of Poisson's solve (0: one per core; more than 1 is faster but not the same "
+        "mesh bit for bit from run to run)");
   r.Add("mesh.bound_voxel_mm", &m.bound_voxel_mm,
         "lattice step of the closed mesh cut back to the space not seen empty, mm");
   r.Add("mesh.bound_keep_seen_mm", &m.bound_keep_seen_mm,

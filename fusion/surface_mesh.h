@@ -35,10 +35,12 @@ struct MeshingOptions {
   /// rather than running into its faces.
   double poisson_scale = 1.5;
   /// Threads of Poisson's octree solve (PCL's OpenMP; 0: one per core). The solve is most of
-  /// the export (1.7-2.6 s of 2.0-3.0 s on the paper's whole sessions on one thread), and at
-  /// the end of a scan the other threads are idle. A build under ThreadSanitizer uses 1 whatever
+  /// the export (1.7-2.6 s of 2.0-3.0 s on the paper's whole sessions on one thread); on two
+  /// threads it took 0-15 % less, but its sums then run in another order each time and the
+  /// mesh is no longer the same bit for bit from run to run (a run's options.conf read back
+  /// must make the same mesh): one by default. A build under ThreadSanitizer uses 1 whatever
   /// this says: libgomp is not instrumented, and its threads' work would be reported as races.
-  int poisson_threads = 0;
+  int poisson_threads = 1;
   /// The closed mesh is cut back to the space no view saw empty (closure_bound.h), remeshed on
   /// a lattice of this step (mm; about the TSDF's 1.37 mm voxel, finer than Poisson's detail
   /// on a hand-held object); within `bound_keep_seen_mm` of the seen surface nothing is cut.
