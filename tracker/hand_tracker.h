@@ -87,8 +87,8 @@ struct TrackerOptions {
   /// tools/bench_hand_init.sh (docs/tracker.md). A frame whose thumb it moved stays tracked
   /// (TrackResult::thumb_moved): the hand's motion across it still carries a held object. Off by
   /// default: with it (and GraspSideOptions::opposition_weight 10) fewer fits flipped on the 72
-  /// generated grasps (33 → 17), but on 22 scripted full turns the scans followed 81 → 76 % of
-  /// the turn, used contacts in 56 → 48 % of the grasping frames, Chamfer 1.73 → 2.19 mm.
+  /// generated grasps (33 → 17), but on 22 scripted full turns the scans followed 85 → 81 % of
+  /// the turn, used contacts in 60 → 51 % of the grasping frames, Chamfer 1.40 → 1.83 mm.
   bool thumb_check = false;
   /// A search that a run of doubtful fits starts runs beside the tracking instead of stalling
   /// it: the tracker goes on fitting each frame from its last pose, and once the search is done
