@@ -98,6 +98,11 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (fused.hand_turn != fusion::HandTurn::kUnknown) {
       entry["hand_turn"] = fusion::ToString(fused.hand_turn);
       if (fused.hand_turn == fusion::HandTurn::kBack) ++hand_back_frames_;
+      if (fused.hand_turn == fusion::HandTurn::kUndecided) ++hand_undecided_frames_;
+    }
+    if (fused.hand_caught_up_deg > 0) {
+      entry["hand_caught_up_deg"] = fused.hand_caught_up_deg;
+      hand_caught_up_deg_ += fused.hand_caught_up_deg;
     }
     if (fused.hand_carried_deg > 0) {
       entry["hand_carried_deg"] = fused.hand_carried_deg;
@@ -170,6 +175,8 @@ nlohmann::json ScanRecord::Summary() const {
                             {"loop_corrections", loop_corrections_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},
+                            {"hand_undecided_frames", hand_undecided_frames_},
+                            {"hand_caught_up_deg", hand_caught_up_deg_},
                             {"fusion_status_counts", fusion_counts_},
                             {"skip_reasons", skip_reasons_},
                             {"coverage", coverage_},

@@ -79,6 +79,8 @@ class ScanRecord {
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;
   std::int64_t hand_back_frames_ = 0;
+  std::int64_t hand_undecided_frames_ = 0;
+  double hand_caught_up_deg_ = 0;
   std::vector<std::string> frame_json_;  // One serialised object per recorded frame.
   std::map<std::string, std::int64_t> track_counts_, fusion_counts_, skip_reasons_;
   std::map<std::string, std::pair<double, std::int64_t>> stage_ms_;  // Sum and count.

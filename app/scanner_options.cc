@@ -358,6 +358,12 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "the net turn's least share of all the turning in those frames");
   r.Add("fusion.turn_carry.smoothing_frames", &u.turn_carry.smoothing_frames,
         "frames the hand's turn is averaged over to tell turning on from back");
+  r.Add("fusion.turn_carry.undecided_to_contacts", &u.turn_carry.undecided_to_contacts,
+        "a hand turning neither on nor back leaves the frame to the contacts (off: taken for a "
+        "turn back)");
+  r.Add("fusion.turn_carry.catch_up_frames", &u.turn_carry.catch_up_frames,
+        "once the turn is recognised, the object catches up the hand's turn in the last this "
+        "many frames nothing registered (0: none)");
   r.Add("fusion.turn_carry.recognise_max_frame_deg", &u.turn_carry.recognise_max_frame_deg,
         "a frame's turn counts at most this much towards recognising it, degrees");
   r.Add("fusion.turn_carry.max_frame_turn_deg", &u.turn_carry.max_frame_turn_deg,

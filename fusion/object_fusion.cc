@@ -124,6 +124,18 @@ void ObjectFusion::UpdateAnchors(const std::vector<PointMatch>& contacts,
   anchors_ = std::move(held);
 }
 
+void ObjectFusion::CatchUpTurn(FusionResult* result) {
+  const double radians = turn_carry_.TakeCatchUp();
+  if (radians <= 0 || !options_.turn_carry.enabled || !turn_carry_.SurfaceLeavesTurnFree()) return;
+  const Rigid3 caught_up =
+      turn_carry_.Turn(cam_from_object_, cam_from_object_ * pivot_in_object_, radians);
+  // An anchor stays where the camera saw it; in the object frame it moves back by the turn.
+  const Rigid3 update = caught_up.Inverse() * cam_from_object_;
+  for (auto& [id, anchor] : anchors_) anchor.object_point = update * anchor.object_point;
+  cam_from_object_ = caught_up;
+  result->hand_caught_up_deg = radians * 180.0 / M_PI;
+}
+
 FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   const auto started_at = SteadyClock::now();
   IHS_CHECK_ARG(input.frame != nullptr && input.object_mask != nullptr,
@@ -171,7 +183,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   Integrate(input, object, pose, &result);
   UpdateAnchors(contacts, pose);
   if (result.icp.ok) pivot_in_object_ = pose.Inverse() * result.icp.pivot;
-  turn_carry_.Learn(result.ContactsUsed());
+  turn_carry_.Learn(result.ContactsUsed(), result.ContactsUsed() || result.pairwise.ok);
+  CatchUpTurn(&result);
   return finish(FusionStatus::kFused);
 }
 

@@ -148,6 +148,9 @@ struct FusionResult {
   /// the frame, degrees. Where it turned back, the contacts were not used.
   HandTurn hand_turn = HandTurn::kUnknown;
   double hand_carried_deg = 0;
+  /// Where this frame recognised the one-way turn: the turn of the earlier frames nothing
+  /// registered, caught up from the next frame on (TurnCarryOptions::catch_up_frames), degrees.
+  double hand_caught_up_deg = 0;
   /// Whether the contacts took part: in the registration or as ICP's anchors.
   bool ContactsUsed() const { return pairwise.contacts > 0 || icp_anchors > 0; }
   /// The contacts' disagreement with the final pose in this frame (median distance, mm; 0
@@ -268,6 +271,9 @@ class ObjectFusion {
   int ApplyAnchors(std::vector<PointMatch>* contacts) const;
   // After registering at `cam_from_object`: anchors of the contacts still held, updated.
   void UpdateAnchors(const std::vector<PointMatch>& contacts, const Rigid3& cam_from_object);
+  // Where this frame recognised the one-way turn, turns the pose on by what the frames before
+  // missed (TurnCarry::TakeCatchUp), the anchors kept where the camera saw them.
+  void CatchUpTurn(FusionResult* result);
 
   struct Anchor {
     Eigen::Vector3d object_point;

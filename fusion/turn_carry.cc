@@ -26,6 +26,8 @@ void TurnCarryOptions::Check() const {
                 "fusion.turn_carry.surface_frames must be in [1, 1000]");
   IHS_CHECK_ARG(min_free_share >= 0 && min_free_share <= 1,
                 "fusion.turn_carry.min_free_share must be in [0, 1]");
+  IHS_CHECK_ARG(catch_up_frames >= 0 && catch_up_frames <= 10000,
+                "fusion.turn_carry.catch_up_frames must be in [0, 10000]");
 }
 
 const char* ToString(HandTurn turn) {
@@ -36,6 +38,8 @@ const char* ToString(HandTurn turn) {
       return "on";
     case HandTurn::kBack:
       return "back";
+    case HandTurn::kUndecided:
+      return "undecided";
   }
   return "unknown";
 }
@@ -65,11 +69,17 @@ HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3
     axis_ = turned_on_.normalized();
     return HandTurn::kOn;
   }
+  if (options_.undecided_to_contacts && !(along < 0 && mean < 0)) return HandTurn::kUndecided;
   return HandTurn::kBack;
 }
 
-void TurnCarry::Learn(bool contacts_used) {
-  if (recognised_ || !contacts_used || !turn_) return;
+void TurnCarry::Learn(bool contacts_used, bool registered) {
+  if (recognised_ || !turn_) return;
+  if (options_.catch_up_frames > 0) {
+    history_.emplace_back(*turn_, registered);
+    while (static_cast<int>(history_.size()) > options_.catch_up_frames) history_.pop_front();
+  }
+  if (!contacts_used) return;
   const double most = options_.recognise_max_frame_deg * M_PI / 180.0;
   contact_turns_.push_back(turn_->norm() > most ? Eigen::Vector3d(turn_->normalized() * most)
                                                 : *turn_);
@@ -92,7 +102,30 @@ void TurnCarry::Recognise() {
     axis_ = net.normalized();
     turned_on_ = net;
     contact_turns_.clear();
+    catch_up_rad_ = MissedTurn();
+    history_.clear();
   }
+}
+
+double TurnCarry::MissedTurn() const {
+  // The frames judged as Judge would have, had the axis been known: on in the frame and on
+  // average, and nothing registered them.
+  std::deque<double> recent;
+  double missed = 0;
+  for (const auto& [turn, registered] : history_) {
+    const double along = turn.dot(axis_);
+    recent.push_back(along);
+    while (static_cast<int>(recent.size()) > options_.smoothing_frames) recent.pop_front();
+    const double mean = std::accumulate(recent.begin(), recent.end(), 0.0) / recent.size();
+    if (!registered && along > 0 && mean > 0) missed += along;
+  }
+  return missed;
+}
+
+double TurnCarry::TakeCatchUp() {
+  const double catch_up = catch_up_rad_;
+  catch_up_rad_ = 0;
+  return catch_up;
 }
 
 void TurnCarry::ObserveSurface(int free_directions) {
@@ -110,8 +143,13 @@ bool TurnCarry::SurfaceLeavesTurnFree() const {
 }
 
 Rigid3 TurnCarry::Carry(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot) const {
+  return Turn(cam_from_object, pivot, carried_rad_);
+}
+
+Rigid3 TurnCarry::Turn(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot,
+                       double radians) const {
   const Eigen::Vector3d axis = cam_from_object.rotation() * axis_;
-  const Rigid3 turn = Rigid3::Translation(pivot) * Rigid3::FromAxisAngle(axis, carried_rad_) *
+  const Rigid3 turn = Rigid3::Translation(pivot) * Rigid3::FromAxisAngle(axis, radians) *
                       Rigid3::Translation(-pivot);
   return turn * cam_from_object;
 }

@@ -13,11 +13,13 @@
 // where the hand turns on that way, the object turns with it in the directions its surface
 // leaves free (where nothing else registers the frame); where the hand turns back, it does not,
 // whatever contacts were found. Motions that go back and forth (the paper's recorded sessions)
-// never show a consistent one-way turn, and then nothing changes.
+// never show a consistent one-way turn, and then nothing changes. The turn of the frames before
+// it was recognised that nothing registered is caught up once it is (TakeCatchUp).
 
 #include <Eigen/Core>
 #include <deque>
 #include <optional>
+#include <utility>
 
 #include "core/rigid3.h"
 
@@ -46,6 +48,18 @@ struct TurnCarryOptions {
   /// frame and on average over the last this many frames (one frame's fitting noise is not a
   /// stroke).
   int smoothing_frames = 3;
+  /// A hand that turns neither on nor back (its turn in the frame and its average disagree: a
+  /// stroke that starts or ends, a hand held still) leaves the frame to the contacts
+  /// (kUndecided), nothing carried; only a hand turning back in the frame and on average keeps
+  /// them out. Off: such a frame is taken for a turn back. The fitted hand lags a stroke's start
+  /// (its turn 0-0.2° a frame while the truth's palm turns 0.1-1.3° and the object 0.2-3.2°):
+  /// taken for turns back, up to fourteen frames of a stroke were lost (docs/fusion.md).
+  bool undecided_to_contacts = true;
+  /// When the one-way turn is recognised, the object catches up the turn of the last this many
+  /// frames that nothing registered (no contacts, no features): the hand's turn on in each, as
+  /// it would have been carried had the turn been known (0: none). The first stroke of a turn
+  /// is recognised only 20-40 frames in, and its frames without contacts were lost.
+  int catch_up_frames = 60;
   /// A hand that turns farther than this in one frame was refitted rather than followed (a
   /// fit that flipped, a search): its motion says nothing of the object's, degrees.
   double max_frame_turn_deg = 15.0;
@@ -62,12 +76,13 @@ struct TurnCarryOptions {
 
 /// How the hand turns in a frame, relative to the recognised one-way turn.
 enum class HandTurn {
-  kUnknown,  ///< No one-way turn recognised yet, or no hand motion in this frame.
-  kOn,       ///< The hand turns on the recognised way: it carries the object.
-  kBack,     ///< It turns back (or stands): the object stays.
+  kUnknown,    ///< No one-way turn recognised yet, or no hand motion in this frame.
+  kOn,         ///< The hand turns on the recognised way: it carries the object.
+  kBack,       ///< It turns back: the object stays, whatever contacts were found.
+  kUndecided,  ///< Neither (TurnCarryOptions::undecided_to_contacts): the contacts decide.
 };
 
-/// A short name for stats ("unknown", "on", "back").
+/// A short name for stats ("unknown", "on", "back", "undecided").
 const char* ToString(HandTurn turn);
 
 /// Recognises the one-way turn and judges each frame's hand motion against it. Not
@@ -80,8 +95,11 @@ class TurnCarry {
   /// from the previous frame) with the object's previous pose: how the hand turns.
   HandTurn Judge(const std::optional<Rigid3>& hand_motion, const Rigid3& cam_from_object);
   /// After the frame: whether its contacts moved the object (the frames the one-way turn is
-  /// recognised from).
-  void Learn(bool contacts_used);
+  /// recognised from), and whether anything registered it (contacts or features).
+  void Learn(bool contacts_used, bool registered);
+  /// Where the last Learn recognised the turn, what the frames before it missed (radians about
+  /// axis(); see `catch_up_frames`); 0 otherwise, and once taken.
+  double TakeCatchUp();
   /// After ICP: how many directions the surface left free (-1: not judged, ignored).
   void ObserveSurface(int free_directions);
   /// Whether the surface has been leaving a direction free (see `min_free_share`).
@@ -89,6 +107,9 @@ class TurnCarry {
   /// The object's previous pose carried by this frame's turn (after Judge returned kOn) about
   /// `pivot` (camera frame), and the angle, radians.
   Rigid3 Carry(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot) const;
+  /// `cam_from_object` turned by `radians` about the recognised axis through `pivot` (camera
+  /// frame).
+  Rigid3 Turn(const Rigid3& cam_from_object, const Eigen::Vector3d& pivot, double radians) const;
   double carried_rad() const { return carried_rad_; }
 
   bool recognised() const { return recognised_; }
@@ -98,6 +119,8 @@ class TurnCarry {
 
  private:
   void Recognise();
+  // The turn on of the frames in history_ that nothing registered, about axis_ (radians).
+  double MissedTurn() const;
 
   TurnCarryOptions options_;
   bool recognised_ = false;
@@ -108,6 +131,10 @@ class TurnCarry {
   std::optional<Eigen::Vector3d> turn_;
   // The hand's turns of the last frames whose contacts moved the object (object frame).
   std::deque<Eigen::Vector3d> contact_turns_;
+  // Before recognition, the hand's turn of the last frames and whether something registered
+  // them (object frame).
+  std::deque<std::pair<Eigen::Vector3d, bool>> history_;
+  double catch_up_rad_ = 0;
   // The hand's turn about the axis in the last frames (radians; cleared where it is unknown).
   std::deque<double> along_axis_;
   // Whether ICP found a free direction, in the last frames where it judged.

@@ -147,12 +147,15 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
         count(summary, "keyframes"), loops, count(summary, "loop_corrections"));
   }
   if (const int carried = count(summary, "hand_carried_frames"),
-      back = count(summary, "hand_back_frames");
-      carried + back > 0) {
+      back = count(summary, "hand_back_frames"),
+      undecided = count(summary, "hand_undecided_frames");
+      carried + back + undecided > 0) {
     std::printf(
         "  the object turned one way: the hand carried its free turn in %d frames, turned back "
-        "without it in %d\n",
-        carried, back);
+        "without it in %d, left it to the contacts in %d; %.0f° missed before the turn was "
+        "recognised caught up\n",
+        carried, back, undecided,
+        summary.contains("hand_caught_up_deg") ? summary["hand_caught_up_deg"].get<double>() : 0.0);
   }
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
