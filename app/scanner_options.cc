@@ -400,7 +400,8 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
   r.Add("mesh.smoothing_alpha", &m.smoothing_alpha, "HC alpha (Vollmer et al.: 0)");
   r.Add("mesh.smoothing_beta", &m.smoothing_beta, "HC beta (Vollmer et al.: 0.5)");
   r.Add("mesh.poisson", &m.poisson, "Poisson reconstruction into a watertight mesh");
-  r.Add("mesh.poisson_depth", &m.poisson_depth, "Poisson octree depth (paper: 10)");
+  r.Add("mesh.poisson_depth", &m.poisson_depth,
+        "Poisson octree depth (paper: 10; 9 is finer than the TSDF's voxels)");
   r.Add("mesh.poisson_samples_per_node", &m.poisson_samples_per_node,
         "Poisson minimum samples per octree node");
   r.Add("mesh.poisson_scale", &m.poisson_scale, "Poisson cube edge over the points' bounding box");
