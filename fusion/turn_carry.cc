@@ -46,6 +46,17 @@ const char* ToString(HandTurn turn) {
 
 TurnCarry::TurnCarry(TurnCarryOptions options) : options_((options.Check(), options)) {}
 
+namespace {
+
+// `value` appended to the last `frames` values (the oldest dropped), and their mean.
+double PushedMean(std::deque<double>* recent, double value, int frames) {
+  recent->push_back(value);
+  while (static_cast<int>(recent->size()) > frames) recent->pop_front();
+  return std::accumulate(recent->begin(), recent->end(), 0.0) / static_cast<double>(recent->size());
+}
+
+}  // namespace
+
 HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3& cam_from_object) {
   turn_.reset();
   carried_rad_ = 0;
@@ -58,10 +69,7 @@ HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3
   turn_ = cam_from_object.rotation().transpose() * (step.axis() * step.angle());
   if (!recognised_) return HandTurn::kUnknown;
   const double along = turn_->dot(axis_);
-  along_axis_.push_back(along);
-  while (static_cast<int>(along_axis_.size()) > options_.smoothing_frames) along_axis_.pop_front();
-  const double mean =
-      std::accumulate(along_axis_.begin(), along_axis_.end(), 0.0) / along_axis_.size();
+  const double mean = PushedMean(&along_axis_, along, options_.smoothing_frames);
   if (along > 0 && mean > 0) {
     carried_rad_ = along;
     // The axis follows the hand's turns on (their wobble about other axes averages out).
@@ -114,9 +122,7 @@ double TurnCarry::MissedTurn() const {
   double missed = 0;
   for (const auto& [turn, registered] : history_) {
     const double along = turn.dot(axis_);
-    recent.push_back(along);
-    while (static_cast<int>(recent.size()) > options_.smoothing_frames) recent.pop_front();
-    const double mean = std::accumulate(recent.begin(), recent.end(), 0.0) / recent.size();
+    const double mean = PushedMean(&recent, along, options_.smoothing_frames);
     if (!registered && along > 0 && mean > 0) missed += along;
   }
   return missed;
