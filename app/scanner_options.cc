@@ -87,6 +87,8 @@ void AddHandFitOptions(OptionRegistry& r, tracker::HandFitOptions* fit) {
         "model points this close to the silhouette count as inside, px");
   r.Add("tracker.fit.unlabelled_match_mm", &f.unlabelled_match_mm,
         "a seen model point is paired with an unsegmented depth pixel this near, mm (0: never)");
+  r.Add("tracker.fit.contact_surface_weight", &f.contact_surface_weight,
+        "pull of the fingertips touching in the previous frame onto the object's surface (0: off)");
   r.Add("tracker.fit.initial_trust_radius", &f.initial_trust_radius,
         "initial Levenberg-Marquardt trust region");
 }

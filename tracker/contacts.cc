@@ -1,11 +1,11 @@
 #include "tracker/contacts.h"
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
 #include "core/check.h"
 #include "core/point_kd_tree.h"
+#include "tracker/local_surface.h"
 
 namespace ihs::tracker {
 
@@ -46,52 +46,6 @@ ContactDetector::ContactDetector(const HandModel& model, ContactOptions options)
   }
 }
 
-namespace {
-
-// A sphere, or (radius 0) a plane, through points near a fingertip.
-struct LocalSurface {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();   // The sphere's; a point of the plane.
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // The plane's.
-  double radius = 0;
-
-  double Distance(const Eigen::Vector3d& p) const {
-    return radius > 0 ? std::abs((p - centre).norm() - radius) : std::abs(normal.dot(p - centre));
-  }
-};
-
-// The sphere fitted algebraically to `points` (at least 4; |x|² + a·x + d = 0 in least squares,
-// about their mean), or the plane of their least spread where that is no sphere of at most
-// `max_radius` mm.
-LocalSurface FitLocalSurface(const std::vector<Eigen::Vector3d>& points, double max_radius) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& p : points) mean += p;
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix4d normal_equations = Eigen::Matrix4d::Zero();
-  Eigen::Vector4d rhs = Eigen::Vector4d::Zero();
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3d& p : points) {
-    const Eigen::Vector3d q = p - mean;
-    const Eigen::Vector4d row(q.x(), q.y(), q.z(), 1.0);
-    normal_equations += row * row.transpose();
-    rhs -= row * q.squaredNorm();
-    scatter += q * q.transpose();
-  }
-  const Eigen::Vector4d x = normal_equations.ldlt().solve(rhs);
-  const Eigen::Vector3d centre = -0.5 * x.head<3>();
-  const double radius_sq = centre.squaredNorm() - x(3);
-  LocalSurface surface;
-  if (x.allFinite() && radius_sq > 0 && radius_sq < max_radius * max_radius) {
-    surface.centre = mean + centre;
-    surface.radius = std::sqrt(radius_sq);
-  } else {
-    surface.centre = mean;
-    surface.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
-  }
-  return surface;
-}
-
-}  // namespace
-
 std::vector<float> ContactDetector::SurfaceDistances(
     size_t e, const std::vector<Eigen::Vector3f>& posed_vertices,
     const std::vector<Eigen::Vector3f>& object_points) const {
@@ -101,21 +55,13 @@ std::vector<float> ContactDetector::SurfaceDistances(
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();
   for (int v : tip) centre += posed_vertices[v];
   centre /= static_cast<float>(tip.size());
-  std::vector<Eigen::Vector3d> patch;
-  const double reach = options_.surface_patch_mm;
-  for (const Eigen::Vector3f& p : object_points) {
-    if ((p - centre).squaredNorm() <= reach * reach) patch.push_back(p.cast<double>());
-  }
-  if (static_cast<int>(patch.size()) < options_.surface_min_points) return distances;
-  // A surface curved more gently than a 1 m sphere is taken as flat.
-  const LocalSurface surface = FitLocalSurface(patch, 1000.0);
-  double sum_sq = 0;
-  for (const Eigen::Vector3d& p : patch) sum_sq += std::pow(surface.Distance(p), 2);
   // Points that no sphere or plane explains (an edge, two surfaces) are not continued.
-  if (std::sqrt(sum_sq / static_cast<double>(patch.size())) > options_.surface_max_rms_mm)
-    return distances;
+  const std::optional<LocalSurface> surface =
+      SurfaceAround(centre, object_points, options_.surface_patch_mm, options_.surface_min_points,
+                    options_.surface_max_rms_mm);
+  if (!surface) return distances;
   for (size_t i = 0; i < tip.size(); ++i) {
-    distances[i] = static_cast<float>(surface.Distance(posed_vertices[tip[i]].cast<double>()));
+    distances[i] = static_cast<float>(surface->Distance(posed_vertices[tip[i]].cast<double>()));
   }
   return distances;
 }

@@ -87,6 +87,9 @@ class ContactDetector {
 
   /// The vertices of each end-effector (those skinned mostly to it), EndEffectors order.
   const std::vector<std::vector<int>>& fingertip_vertices() const { return fingertip_vertices_; }
+  /// Per end-effector, the vertices within the threshold that make it a contact bone (the
+  /// pad's share of the fingertip).
+  const std::vector<int>& min_vertices() const { return min_vertices_; }
 
  private:
   const ContactOptions options_;

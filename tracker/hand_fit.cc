@@ -157,6 +157,7 @@ void HandFitOptions::Check() const {
   IHS_CHECK_ARG(data_point_weight >= 0, "hand_fit.data_point_weight must be >= 0");
   IHS_CHECK_ARG(silhouette_weight >= 0 && silhouette_tolerance_px >= 0,
                 "hand_fit.silhouette_weight and silhouette_tolerance_px must be >= 0");
+  IHS_CHECK_ARG(contact_surface_weight >= 0, "hand_fit.contact_surface_weight must be >= 0");
 }
 
 // Precomputed per model: sample vertices and collision capsules.
@@ -231,7 +232,8 @@ HandFitter::~HandFitter() = default;
 class HandFitter::FitState {
  public:
   FitState(const HandFitter& fitter, const std::vector<Eigen::Vector3f>& hand_points,
-           const Frame* frame, const HandPose& initial, const Segmentation* segmentation);
+           const Frame* frame, const HandPose& initial, const Segmentation* segmentation,
+           const std::vector<SurfaceContact>& contacts);
 
   /// One correspondence update (`first`: the fit's first): pairs the model at the current pose
   /// with the data and solves the inner problem from there. False, with the pose left as it
@@ -249,6 +251,7 @@ class HandFitter::FitState {
   std::vector<PointPair> ModelToDataPairs(const std::vector<int>& visible_samples) const;
   double NearestUnlabelled(const Eigen::Vector3f& point, Eigen::Vector3d* out) const;
   std::vector<PlanePair> DataToModelPairs() const;
+  std::vector<PlanePair> ContactPairs() const;
   void WeighPairs(std::vector<PointPair>* model_pairs, std::vector<PlanePair>* data_pairs) const;
   std::vector<CollisionPair> CloseCollisions() const;
   void PrepareSilhouette();
@@ -263,6 +266,7 @@ class HandFitter::FitState {
   const Data& precomputed_;  // The fitter's samples and capsules.
   const Frame* const frame_;
   const Segmentation* const segmentation_;
+  const std::vector<SurfaceContact>& contacts_;
 
   // Data: an even subsample for data → model (of the cubes' centroids, or of the points), a
   // denser one for the tree. How well the pose explains the data is measured on the points
@@ -289,13 +293,15 @@ class HandFitter::FitState {
 
 HandFitter::FitState::FitState(const HandFitter& fitter,
                                const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
-                               const HandPose& initial, const Segmentation* segmentation)
+                               const HandPose& initial, const Segmentation* segmentation,
+                               const std::vector<SurfaceContact>& contacts)
     : model_(fitter.model_),
       intrinsics_(fitter.intrinsics_),
       options_(fitter.options_),
       precomputed_(*fitter.data_),
       frame_(frame),
       segmentation_(segmentation),
+      contacts_(contacts),
       measured_(EveryNth(hand_points, static_cast<size_t>(options_.max_data_points))),
       data_(options_.data_voxel_mm > 0
                 ? EveryNth(VoxelCentroids(hand_points, options_.data_voxel_mm),
@@ -320,6 +326,8 @@ bool HandFitter::FitState::Iterate(bool first) {
   std::vector<PlanePair> data_pairs = DataToModelPairs();
   if (model_pairs.empty() && data_pairs.empty()) return false;
   WeighPairs(&model_pairs, &data_pairs);
+  const std::vector<PlanePair> contact_pairs = ContactPairs();
+  data_pairs.insert(data_pairs.end(), contact_pairs.begin(), contact_pairs.end());
   Solve({std::move(model_pairs), std::move(data_pairs), SilhouettePairs(), CloseCollisions()});
   return true;
 }
@@ -472,6 +480,37 @@ std::vector<PlanePair> HandFitter::FitState::DataToModelPairs() const {
         {precomputed_.samples[i], point.cast<double>(), normals_[i], HuberWeight(d)});
   }
   return data_pairs;
+}
+
+// Fingertips held on the object: each one's vertices nearest its surface (at the current pose)
+// to their nearest points there, point to plane, as a mean over them.
+std::vector<PlanePair> HandFitter::FitState::ContactPairs() const {
+  std::vector<PlanePair> pairs;
+  if (options_.contact_surface_weight <= 0) return pairs;
+  std::vector<std::pair<double, size_t>> by_depth;  // Signed distance outside, which vertex.
+  std::vector<Eigen::Vector3d> posed;
+  for (const SurfaceContact& contact : contacts_) {
+    const LocalSurface& surface = contact.surface;
+    by_depth.clear();
+    posed.clear();
+    for (int v : contact.vertices) {
+      const Eigen::Vector3d p =
+          kinematics_.SkinnedPoint(model_.weights[v], model_.rest_mesh.vertices[v], nullptr);
+      by_depth.push_back({surface.NormalAt(p).dot(p - surface.Closest(p)), posed.size()});
+      posed.push_back(p);
+    }
+    const size_t pulled = std::min(by_depth.size(), static_cast<size_t>(contact.pulled));
+    std::partial_sort(by_depth.begin(), by_depth.begin() + pulled, by_depth.end());
+    for (size_t k = 0; k < pulled; ++k) {
+      const Eigen::Vector3d& p = posed[by_depth[k].second];
+      pairs.push_back({contact.vertices[by_depth[k].second], surface.Closest(p),
+                       surface.NormalAt(p), 1.0, 0.0});
+    }
+  }
+  const double scale =
+      pairs.empty() ? 0 : options_.contact_surface_weight / std::sqrt(double(pairs.size()));
+  for (PlanePair& pair : pairs) pair.weight *= scale;
+  return pairs;
 }
 
 // Weighs each direction's pairs as a mean over them, and gives the data → model pairs their
@@ -652,13 +691,14 @@ HandFitResult HandFitter::FitState::Result() {
 }
 
 HandFitResult HandFitter::Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
-                              const HandPose& initial, const Segmentation* segmentation) const {
+                              const HandPose& initial, const Segmentation* segmentation,
+                              const std::vector<SurfaceContact>& contacts) const {
   if (hand_points.empty()) {
     HandFitResult result;
     result.pose = initial;
     return result;
   }
-  FitState state(*this, hand_points, frame, initial, segmentation);
+  FitState state(*this, hand_points, frame, initial, segmentation, contacts);
   for (int outer = 0; outer < options_.outer_iterations; ++outer) {
     if (!state.Iterate(outer == 0)) break;
   }

@@ -12,6 +12,7 @@
 #include "core/frame.h"
 #include "tracker/hand_model.h"
 #include "tracker/hand_pose.h"
+#include "tracker/local_surface.h"
 #include "tracker/segmentation.h"
 
 namespace ihs::tracker {
@@ -81,6 +82,13 @@ struct HandFitOptions {
   /// fit. Measured on twelve 300-frame stretches of the recorded motions it was slightly worse
   /// (docs/tracker.md), hence off.
   double unlabelled_match_mm = 0.0;
+  /// Weight of the pull of fingertips held in contact onto the object's surface under them
+  /// (SurfaceContact; the tracker passes the fingertips found touching in the previous frame):
+  /// each held fingertip's vertices nearest that surface are pulled onto it, point to plane,
+  /// as a mean over them like the data terms (relative to those). A fingertip that goes round
+  /// behind the object loses the depth that placed it and the fit lets it wander off the
+  /// surface it holds; 0: off.
+  double contact_surface_weight = 0.0;
   /// Initial Levenberg–Marquardt trust region: correspondences hold only near the current pose.
   double initial_trust_radius = 10.0;
   /// The volume the hand points were cropped to (camera frame, mm): model points outside it
@@ -108,6 +116,17 @@ struct HandFitResult {
   int data_points = 0;
 };
 
+/// A fingertip held on the object's surface (HandFitOptions::contact_surface_weight).
+struct SurfaceContact {
+  /// The fingertip's skin vertices (model vertex indices).
+  std::vector<int> vertices;
+  /// How many of them, those nearest the surface (or deepest inside it), are pulled onto it:
+  /// the pad's share of the fingertip.
+  int pulled = 1;
+  /// The surface under the fingertip (camera frame).
+  LocalSurface surface;
+};
+
 /// Fits a hand model to hand points. Holds the model (by reference: it must outlive the
 /// fitter) and its collision proxies.
 class HandFitter {
@@ -120,9 +139,11 @@ class HandFitter {
   /// frame, mm). `frame` (optional) is the depth image they came from: model points hidden
   /// behind nearer surfaces (the object) are then not matched. `segmentation` (optional, of
   /// that frame) gives the silhouette the model must stay within. With no points the initial
-  /// pose comes back with zero coverage.
+  /// pose comes back with zero coverage. `contacts`: fingertips held on the object's surface
+  /// (used with HandFitOptions::contact_surface_weight > 0).
   HandFitResult Fit(const std::vector<Eigen::Vector3f>& hand_points, const Frame* frame,
-                    const HandPose& initial, const Segmentation* segmentation = nullptr) const;
+                    const HandPose& initial, const Segmentation* segmentation = nullptr,
+                    const std::vector<SurfaceContact>& contacts = {}) const;
 
   const HandFitOptions& options() const { return options_; }
 

@@ -373,6 +373,34 @@ bool HandTracker::CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, co
   return false;
 }
 
+std::vector<SurfaceContact> HandTracker::HeldContacts(const HandPose& predicted,
+                                                      const Segmentation& segmentation) const {
+  std::vector<SurfaceContact> held;
+  if (options_.fit.contact_surface_weight <= 0 || !has_previous_ || previous_vertices_.empty())
+    return held;
+  // Each fingertip touching in the previous frame, moved as the hand is predicted to move, and
+  // the object's surface seen around it.
+  const Rigid3 moved = predicted.cam_from_root * pose_.cam_from_root.Inverse();
+  const std::vector<int> ends = model_.EndEffectors();
+  const ContactOptions& c = options_.contacts;
+  for (size_t k = 0; k < ends.size() && k < contacts_->fingertip_vertices().size(); ++k) {
+    if (std::find(previous_contact_bones_.begin(), previous_contact_bones_.end(), ends[k]) ==
+        previous_contact_bones_.end()) {
+      continue;
+    }
+    const std::vector<int>& tip = contacts_->fingertip_vertices()[k];
+    if (tip.empty()) continue;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int v : tip) centre += previous_vertices_[v].cast<double>();
+    centre = moved * Eigen::Vector3d(centre / static_cast<double>(tip.size()));
+    const std::optional<LocalSurface> surface =
+        SurfaceAround(centre.cast<float>(), segmentation.object_points, c.surface_patch_mm,
+                      c.surface_min_points, c.surface_max_rms_mm);
+    if (surface) held.push_back({tip, contacts_->min_vertices()[k], *surface});
+  }
+  return held;
+}
+
 TrackResult HandTracker::Track(const Frame& frame) {
   const auto started = SteadyClock::now();
   TrackResult result;
@@ -399,6 +427,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
                     std::to_string(options_.min_hand_points) + ")";
     has_previous_ = false;
     previous_contact_vertices_.clear();
+    previous_contact_bones_.clear();
     return finish();
   }
 
@@ -419,7 +448,8 @@ TrackResult HandTracker::Track(const Frame& frame) {
       predicted.cam_from_root =
           pose_.cam_from_root * previous_pose_.cam_from_root.Inverse() * pose_.cam_from_root;
     }
-    result.fit = fitter_->Fit(points, &frame, predicted, &result.segmentation);
+    result.fit = fitter_->Fit(points, &frame, predicted, &result.segmentation,
+                              HeldContacts(predicted, result.segmentation));
     result.status = TrackStatus::kTracked;
     // A search that ran beside the tracking and is done competes with the tracked fit.
     if (pending_ &&
@@ -524,6 +554,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   result.contacts_ms = MillisecondsSince(stage);
   previous_vertices_ = vertices;
   previous_contact_vertices_ = result.contacts.vertices;
+  previous_contact_bones_ = result.contacts.bones;
   std::sort(previous_contact_vertices_.begin(), previous_contact_vertices_.end());
   return finish();
 }

@@ -232,6 +232,10 @@ class HandTracker {
   // `result`'s fit when it explains the hand better (returns whether it did).
   bool CheckThumb(const std::vector<Eigen::Vector3f>& hand_points, const Frame& frame,
                   TrackResult& result, const GraspSide* side) const;
+  // The fingertips touching in the previous frame (tracked), each with the object's surface
+  // seen around where `predicted` moves it (HandFitOptions::contact_surface_weight).
+  std::vector<SurfaceContact> HeldContacts(const HandPose& predicted,
+                                           const Segmentation& segmentation) const;
   // Builds the fitters and the contact detector for model_.
   void BuildStages();
   // `pose` of the template at scale `from` carried over to scale `to`: same angles, the hand's
@@ -269,6 +273,7 @@ class HandTracker {
   bool has_confident_pose_ = false;
   std::vector<Eigen::Vector3f> previous_vertices_;
   std::vector<int> previous_contact_vertices_;
+  std::vector<int> previous_contact_bones_;
   // A search running beside the tracking; last, so that it is waited for before the stages it
   // uses go.
   std::unique_ptr<PendingSearch> pending_;

@@ -11,6 +11,7 @@
 #include "render/offscreen_renderer.h"
 #include "tests/test_util.h"
 #include "tools/synth/sequence.h"
+#include "tracker/contacts.h"
 #include "tracker/hand_data.h"
 #include "tracker/hand_fit_cost.h"
 #include "tracker/hand_kinematics.h"
@@ -206,6 +207,70 @@ TEST(HandFitOptionsTest, BadValuesAreRefusedNamingTheField) {
   options = HandFitOptions();
   options.data_voxel_mm = -1;
   EXPECT_NE(message(options).find("data_voxel_mm"), std::string::npos);
+}
+
+// The procedural hand at rest, 500 mm before the camera, its index finger bent and its
+// fingertip's points gone from the data (hidden, as behind the object it holds): with the
+// fingertip held on a plane where it touched at rest, the fit puts it back on that plane; without,
+// nothing moves it there.
+TEST(HandFitterTest, AFingertipHeldInContactIsPulledOntoTheSurface) {
+  const HandModel model = LoadHandTemplate("procedural");
+  const ContactDetector detector(model);
+  const std::vector<int> ends = model.EndEffectors();
+  size_t index = 0;  // The index finger's end-effector (finger 3: RFing.3_*).
+  while (index < ends.size() && model.FingerOf(ends[index]) != 3) ++index;
+  ASSERT_LT(index, ends.size());
+  const std::vector<int>& tip = detector.fingertip_vertices()[index];
+  const HandPose rest = HandPose::Rest(model, Rigid3(Eigen::Matrix3d::Identity(),
+                                                     Eigen::Vector3d(0, 0, 500)));
+  TriangleMesh posed = model.Pose(ForwardKinematics(model, rest));
+  posed.ComputeVertexNormals();
+  Eigen::Vector3d hand_centre = Eigen::Vector3d::Zero(), tip_centre = Eigen::Vector3d::Zero();
+  for (const auto& v : posed.vertices) hand_centre += v.cast<double>();
+  hand_centre /= static_cast<double>(posed.vertices.size());
+  for (int v : tip) tip_centre += posed.vertices[v].cast<double>();
+  tip_centre /= static_cast<double>(tip.size());
+  // The plane across the finger's end, touching its farthest vertex; the object beyond it.
+  const Eigen::Vector3d along = (tip_centre - hand_centre).normalized();
+  LocalSurface plane;
+  plane.normal = -along;
+  plane.centre = tip_centre;
+  for (int v : tip) {
+    if (along.dot(posed.vertices[v].cast<double>() - plane.centre) > 0)
+      plane.centre = posed.vertices[v].cast<double>();
+  }
+  // The data: the vertices facing the camera, but those of the fingertip's end.
+  std::vector<Eigen::Vector3f> points;
+  for (size_t v = 0; v < posed.vertices.size(); ++v) {
+    const Eigen::Vector3f& p = posed.vertices[v];
+    if (posed.normals[v].dot(p) < 0 && (p.cast<double>() - tip_centre).norm() > 25) {
+      points.push_back(p);
+    }
+  }
+  HandPose bent = rest;
+  const auto dofs = JointDegreesOfFreedom(model);
+  for (size_t k = 0; k < dofs.size(); ++k) {
+    // Flexion (about y, negative toward the palm) of each of its joints.
+    if (model.FingerOf(dofs[k].bone) == 3 && dofs[k].axis == 1) bent.angles_rad[k] -= 0.35;
+  }
+  auto gap = [&](const HandPose& pose) {  // The fingertip's nearest vertex to the plane, mm.
+    const TriangleMesh mesh = model.Pose(ForwardKinematics(model, pose));
+    double nearest = 1e9;
+    for (int v : tip) nearest = std::min(nearest, plane.Distance(mesh.vertices[v].cast<double>()));
+    return nearest;
+  };
+  HandFitOptions options;
+  options.contact_surface_weight = 0.3;
+  const HandFitter fitter(model, CameraIntrinsics::Carmine109(), options);
+  const std::vector<SurfaceContact> held = {{tip, detector.min_vertices()[index], plane}};
+  const double start = gap(bent);
+  const double free = gap(fitter.Fit(points, nullptr, bent).pose);
+  const double pulled = gap(fitter.Fit(points, nullptr, bent, nullptr, held).pose);
+  std::printf("fingertip to the plane: bent %.1f mm, fitted %.1f mm, held on it %.1f mm\n", start,
+              free, pulled);
+  ASSERT_GT(start, 5.0);
+  EXPECT_GT(free, 8.0);  // Measured: bent 39.7 mm, fitted 13.0, held 0.0.
+  EXPECT_LT(pulled, 1.5);
 }
 
 TEST(HandFitterTest, RecoversAPerturbedPoseOfARenderedHand) {
