@@ -177,6 +177,8 @@ void ObjectStage::Process(FramePacket& packet) {
     input.fingertips = packet.fingertips.get();
   }
   input.hand_motion = hand_motion;
+  input.contact_threshold_mm = packet.track.contacts.threshold_mm;
+  input.contacts_held = packet.track.contacts.held_frames > 0;
   packet.fusion = fusion_.Fuse(input);
 }
 

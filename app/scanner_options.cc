@@ -327,6 +327,9 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "where nothing registers a frame, the object moves on as in the last frame (when the "
         "surface left no direction free there; off by default)");
   r.Add("fusion.min_object_points", &u.min_object_points, "object points a frame needs");
+  r.Add("fusion.loose_contact_mm", &u.loose_contact_mm,
+        "contacts found farther from the object are used only where its surface leaves a turn "
+        "free, mm");
   r.Add("fusion.max_jump_mm", &u.max_jump_mm,
         "a frame moving the object's centre farther than this is rejected, mm");
   r.Add("fusion.max_jump_deg", &u.max_jump_deg,

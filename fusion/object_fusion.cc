@@ -37,6 +37,7 @@ void FusionOptions::Check() const {
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
       "fusion.model_contacts.distance_mm must be less than the TSDF's truncation");
   IHS_CHECK_ARG(min_object_points >= 10, "fusion.min_object_points must be >= 10");
+  IHS_CHECK_ARG(loose_contact_mm > 0, "fusion.loose_contact_mm must be positive");
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
   IHS_CHECK_ARG(anchor_slip_mm > 0, "fusion.anchor_slip_mm must be positive");
@@ -161,7 +162,13 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   // The correspondences' motion (or the hand's turn), then ICP from there.
   result.hand_turn = JudgeHandTurn(input);
   std::vector<PointMatch> contacts;
-  Rigid3 pose = Register(input, result.hand_turn != HandTurn::kBack, &contacts, &result);
+  // None where the hand turns back; the tracker's loose ones only where the surface leaves a
+  // turn free.
+  const bool firm_or_free =
+      (!input.contacts_held && input.contact_threshold_mm <= options_.loose_contact_mm) ||
+      turn_carry_.SurfaceLeavesTurnFree();
+  Rigid3 pose =
+      Register(input, result.hand_turn != HandTurn::kBack, firm_or_free, &contacts, &result);
   if (result.hand_turn == HandTurn::kOn && !result.pairwise.ok) {
     pose = turn_carry_.Carry(cam_from_object_, cam_from_object_ * pivot_in_object_);
     result.hand_carried_deg = turn_carry_.carried_rad() * 180.0 / M_PI;
@@ -295,14 +302,15 @@ void ObjectFusion::ApplyCorrection(const KeyframeUpdate& update, FusionResult* r
 }
 
 Rigid3 ObjectFusion::Register(const FusionInput& input, bool with_contacts,
-                              std::vector<PointMatch>* contacts, FusionResult* result) const {
+                              bool with_tracker_contacts, std::vector<PointMatch>* contacts,
+                              FusionResult* result) const {
   Rigid3 pose = cam_from_object_;
   const auto pairwise_start = SteadyClock::now();
   // The contact sets as one, with the model's contacts and the anchors.
   PairwiseInput correspondences;
   for (const MatchSet& set : input.correspondences.sets) {
     if (set.kind == MatchKind::kVisual) correspondences.sets.push_back(set);
-    if (set.kind == MatchKind::kContact && with_contacts) {
+    if (set.kind == MatchKind::kContact && with_contacts && with_tracker_contacts) {
       contacts->insert(contacts->end(), set.pairs.begin(), set.pairs.end());
     }
   }

@@ -60,6 +60,14 @@ struct FusionOptions {
   bool predict_moving = false;
   /// A frame needs this many object points.
   int min_object_points = 200;
+  /// Fingertip contacts the tracker found only farther than this from the object's points
+  /// (FusionInput::contact_threshold_mm, its grown threshold) are loose, as are those it held
+  /// without finding them (FusionInput::contacts_held): they are used only where the surface
+  /// leaves a turn free (TurnCarryOptions), where nothing but the hand shows the turn. Where
+  /// the surface fixes the motion (a box, a cube) ICP follows the object, and loose contacts —
+  /// a hand lifting off to re-grasp is among them — only pull it along with the hand
+  /// (docs/fusion.md, "Loose contacts").
+  double loose_contact_mm = 10.0;
   /// A pose that moves the object's centre farther than this, or turns it by more than this,
   /// from the previous frame is implausible: the frame is skipped, not integrated.
   double max_jump_mm = 40.0;
@@ -111,6 +119,12 @@ struct FusionInput {
   /// The hand's motion since the previous frame (camera frame: current_from_previous of its
   /// root), where the tracker followed it from there; none otherwise (turn_carry.h).
   std::optional<Rigid3> hand_motion = std::nullopt;
+  /// The distance at which the tracker found this frame's contacts (tracker::Contacts::
+  /// threshold_mm; 0: unknown, taken as firm), and whether it held them without finding them
+  /// in this frame (tracker::GraspHold): held ones are loose too (FusionOptions::
+  /// loose_contact_mm).
+  double contact_threshold_mm = 0;
+  bool contacts_held = false;
 };
 
 /// What happened to a frame.
@@ -239,9 +253,9 @@ class ObjectFusion {
   void ApplyCorrection(const KeyframeUpdate& update, FusionResult* result);
   // The correspondences' motion applied to the previous pose (that pose where the registration
   // fails); `contacts` gets the contact pairs used (the model's included, anchors applied),
-  // none without `with_contacts`.
-  Rigid3 Register(const FusionInput& input, bool with_contacts, std::vector<PointMatch>* contacts,
-                  FusionResult* result) const;
+  // none without `with_contacts`, the model's alone without `with_tracker_contacts`.
+  Rigid3 Register(const FusionInput& input, bool with_contacts, bool with_tracker_contacts,
+                  std::vector<PointMatch>* contacts, FusionResult* result) const;
   // How the hand turns in this frame, where the object's surface leaves a turn free.
   HandTurn JudgeHandTurn(const FusionInput& input);
   // ICP from the registered `pose` (and from the previous one where that pairs too few), which
