@@ -1,5 +1,7 @@
 #include "app/scan_stages.h"
 
+#include <algorithm>
+
 #include "app/object_mask.h"
 #include "core/errors.h"
 #include "core/stopwatch.h"
@@ -145,8 +147,19 @@ std::optional<Rigid3> ObjectStage::HandMotion(const FramePacket& packet) {
   return motion;
 }
 
+void ObjectStage::SetContactLooseness(const FramePacket& packet, fusion::FusionInput* input) {
+  const tracker::Contacts& contacts = packet.track.contacts;
+  const bool held = contacts.held_frames > 0;
+  input->contact_threshold_mm = std::max(contacts.threshold_mm, previous_contact_threshold_mm_);
+  input->contacts_held = held || previous_contacts_held_;
+  previous_contact_threshold_mm_ = contacts.bones.empty() ? 0.0 : contacts.threshold_mm;
+  previous_contacts_held_ = !contacts.bones.empty() && held;
+}
+
 void ObjectStage::Process(FramePacket& packet) {
   std::optional<Rigid3> hand_motion = HandMotion(packet);
+  fusion::FusionInput input;
+  SetContactLooseness(packet, &input);
   if (!packet.frame_error.empty()) {
     packet.fusion = fusion_.Skip("malformed frame: " + packet.frame_error);
     return;
@@ -157,7 +170,6 @@ void ObjectStage::Process(FramePacket& packet) {
     return;
   }
   const Frame& frame = *packet.frame;
-  fusion::FusionInput input;
   input.frame = &frame;
   input.object_mask = &packet.object_mask;
   std::vector<fusion::PointMatch> hand_contacts;
@@ -177,8 +189,6 @@ void ObjectStage::Process(FramePacket& packet) {
     input.fingertips = packet.fingertips.get();
   }
   input.hand_motion = hand_motion;
-  input.contact_threshold_mm = packet.track.contacts.threshold_mm;
-  input.contacts_held = packet.track.contacts.held_frames > 0;
   packet.fusion = fusion_.Fuse(input);
 }
 

@@ -132,12 +132,18 @@ class ObjectStage {
  private:
   // The hand's motion since the previous frame, where the tracker followed it from there.
   std::optional<Rigid3> HandMotion(const FramePacket& packet);
+  // How loose this frame's contact pairs are: each joins a contact of this frame to one of the
+  // previous frame, and is as loose as the looser of the two (FusionOptions::loose_contact_mm).
+  void SetContactLooseness(const FramePacket& packet, fusion::FusionInput* input);
 
   const ScanOptions options_;
   std::vector<std::unique_ptr<fusion::CorrespondenceSource>> sources_;
   fusion::ObjectFusion fusion_;
   // The hand's root pose in the previous frame, where it had one.
   std::optional<Rigid3> previous_root_;
+  // The previous frame's contacts: the threshold they were found at, whether they were held.
+  double previous_contact_threshold_mm_ = 0;
+  bool previous_contacts_held_ = false;
 };
 
 }  // namespace ihs::app

@@ -119,9 +119,10 @@ struct FusionInput {
   /// The hand's motion since the previous frame (camera frame: current_from_previous of its
   /// root), where the tracker followed it from there; none otherwise (turn_carry.h).
   std::optional<Rigid3> hand_motion = std::nullopt;
-  /// The distance at which the tracker found this frame's contacts (tracker::Contacts::
-  /// threshold_mm; 0: unknown, taken as firm), and whether it held them without finding them
-  /// in this frame (tracker::GraspHold): held ones are loose too (FusionOptions::
+  /// The distance at which the tracker found the contacts of the contact pairs
+  /// (tracker::Contacts::threshold_mm; a pair joins this frame's and the previous frame's
+  /// contacts: the larger of the two; 0: unknown, taken as firm), and whether it held either
+  /// without finding them (tracker::GraspHold): held ones are loose too (FusionOptions::
   /// loose_contact_mm).
   double contact_threshold_mm = 0;
   bool contacts_held = false;
