@@ -87,7 +87,9 @@ struct HandFitOptions {
   /// each held fingertip's vertices nearest that surface are pulled onto it, point to plane,
   /// as a mean over them like the data terms (relative to those). A fingertip that goes round
   /// behind the object loses the depth that placed it and the fit lets it wander off the
-  /// surface it holds; 0: off.
+  /// surface it holds. Off (0): on 34 generated full turns it found no more contacts and held
+  /// misplaced fingertips where the fit had put them (docs/tracker.md, "Fingertips held on the
+  /// object's surface").
   double contact_surface_weight = 0.0;
   /// Initial Levenberg–Marquardt trust region: correspondences hold only near the current pose.
   double initial_trust_radius = 10.0;
