@@ -43,6 +43,7 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (track.doubtful) entry["track_doubtful"] = true, ++doubtful_frames_;
     if (track.turned_over) entry["track_turned_over"] = true, ++turned_over_frames_;
     if (track.thumb_moved) entry["track_thumb_moved"] = true, ++thumb_moved_frames_;
+    if (track.grasp_let_go) entry["grasp_let_go"] = true, ++let_go_frames_;
     timing("track_ms", track.milliseconds);
     timing("segmentation_ms", track.segmentation_ms);
     timing("hand_fit_ms", track.fit_ms);
@@ -169,6 +170,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"hand_turned_over_frames", turned_over_frames_},
                             {"hand_thumb_moved_frames", thumb_moved_frames_},
                             {"held_grasp_frames", held_grasp_frames_},
+                            {"grasps_let_go", let_go_frames_},
                             {"icp_slid_frames", icp_slid_frames_},
                             {"keyframes", keyframes_},
                             {"loops", loops_},

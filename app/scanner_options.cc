@@ -128,6 +128,20 @@ void AddGraspHoldOptions(OptionRegistry& r, tracker::GraspHoldOptions* hold) {
         "frames in a row a grasp is held without being detected at most");
 }
 
+void AddReleaseOptions(OptionRegistry& r, tracker::ReleaseOptions* release) {
+  tracker::ReleaseOptions& o = *release;
+  r.Add("tracker.release.enabled", &o.enabled,
+        "a grasp whose fingertips rise off the object together is let go: they are no "
+        "contacts until they come back");
+  r.Add("tracker.release.frames", &o.frames, "frames over which the grasp's fingertips rise");
+  r.Add("tracker.release.rise_mm", &o.rise_mm,
+        "how far every fingertip of the grasp rises when it lets go, mm");
+  r.Add("tracker.release.return_mm", &o.return_mm,
+        "a let-go fingertip counts again within this of where it was before, mm");
+  r.Add("tracker.release.max_frames", &o.max_frames,
+        "frames a fingertip stays let go at most");
+}
+
 void AddGraspSideOptions(OptionRegistry& r, tracker::GraspSideOptions* side) {
   tracker::GraspSideOptions& g = *side;
   r.Add("tracker.grasp_side.weight", &g.weight,
@@ -300,6 +314,7 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
   AddHandFitOptions(r, &t.fit);
   AddContactOptions(r, &t.contacts);
   AddGraspHoldOptions(r, &t.grasp_hold);
+  AddReleaseOptions(r, &t.release);
   AddGraspSideOptions(r, &t.grasp_side);
 }
 

@@ -66,9 +66,8 @@ std::vector<float> ContactDetector::SurfaceDistances(
   return distances;
 }
 
-Contacts ContactDetector::Detect(const std::vector<Eigen::Vector3f>& posed_vertices,
-                                 const PointKdTree& object_points) const {
-  Contacts contacts;
+std::vector<double> ContactDetector::TipDistances(
+    const std::vector<Eigen::Vector3f>& posed_vertices, const PointKdTree& object_points) const {
   // Distance of every fingertip vertex to the object, once.
   std::vector<std::vector<float>> distances(end_effectors_.size());
   for (size_t e = 0; e < end_effectors_.size(); ++e) {
@@ -90,12 +89,37 @@ Contacts ContactDetector::Detect(const std::vector<Eigen::Vector3f>& posed_verti
       }
     }
   }
+  // A fingertip is a contact bone at a threshold where more than its min_vertices vertices lie
+  // within it: from its (min_vertices + 1)-th nearest vertex's distance on.
+  std::vector<double> tip_distance_mm(end_effectors_.size(), kNoContactMm);
+  for (size_t e = 0; e < end_effectors_.size(); ++e) {
+    std::vector<float>& d = distances[e];
+    const size_t k = static_cast<size_t>(min_vertices_[e]);
+    if (d.size() <= k) continue;
+    std::nth_element(d.begin(), d.begin() + k, d.end());
+    tip_distance_mm[e] = std::min<double>(d[k], kNoContactMm);
+  }
+  return tip_distance_mm;
+}
+
+Contacts ContactDetector::Detect(const std::vector<Eigen::Vector3f>& posed_vertices,
+                                 const PointKdTree& object_points) const {
+  return Select(TipDistances(posed_vertices, object_points));
+}
+
+Contacts ContactDetector::Select(std::vector<double> tip_distance_mm,
+                                 const std::vector<double>* tip_limits_mm) const {
+  IHS_CHECK_ARG(tip_distance_mm.size() == end_effectors_.size() &&
+                    (!tip_limits_mm || tip_limits_mm->size() == end_effectors_.size()),
+                "contacts: one distance (and limit) per end-effector");
+  Contacts contacts;
+  contacts.tip_distance_mm = std::move(tip_distance_mm);
   auto bones_within = [&](double threshold) {
     std::vector<int> bones;
     for (size_t e = 0; e < end_effectors_.size(); ++e) {
-      const auto close = std::count_if(distances[e].begin(), distances[e].end(),
-                                       [&](float d) { return d <= threshold; });
-      if (close > min_vertices_[e]) bones.push_back(end_effectors_[e]);
+      const double limit = tip_limits_mm ? (*tip_limits_mm)[e] : kNoContactMm;
+      if (contacts.tip_distance_mm[e] <= std::min(threshold, limit))
+        bones.push_back(end_effectors_[e]);
     }
     return bones;
   };

@@ -62,6 +62,9 @@ struct ContactOptions {
   void Check() const;
 };
 
+/// A fingertip's contact distance where no vertex of it has an object point near (mm).
+inline constexpr double kNoContactMm = 1e9;
+
 /// The contacts of one frame.
 struct Contacts {
   /// End-effector bones in contact, and all their vertices (the contact vertices).
@@ -73,6 +76,10 @@ struct Contacts {
   /// 0 when detected in this frame; else how many frames the grasp has been held without
   /// being detected (GraspHold), this one included.
   int held_frames = 0;
+  /// Per end-effector (HandModel::EndEffectors order), the smallest threshold at which the
+  /// detection counts it a contact bone, mm (kNoContactMm where none would): how far its pad
+  /// is from the object's surface.
+  std::vector<double> tip_distance_mm;
 };
 
 /// Finds contacts of a posed hand with the object's points.
@@ -81,9 +88,16 @@ class ContactDetector {
   explicit ContactDetector(const HandModel& model, ContactOptions options = {});
 
   /// `posed_vertices`: the hand's skin vertices in the camera frame (model vertex order);
-  /// `object_points`: a tree over the object's points (camera frame).
+  /// `object_points`: a tree over the object's points (camera frame). Select(TipDistances()).
   Contacts Detect(const std::vector<Eigen::Vector3f>& posed_vertices,
                   const PointKdTree& object_points) const;
+  /// Each end-effector's contact distance (Contacts::tip_distance_mm).
+  std::vector<double> TipDistances(const std::vector<Eigen::Vector3f>& posed_vertices,
+                                   const PointKdTree& object_points) const;
+  /// The contacts of these contact distances; `tip_limits_mm`, where given, per end-effector
+  /// the largest threshold at which it may count (ReleaseWatch::Limits).
+  Contacts Select(std::vector<double> tip_distance_mm,
+                  const std::vector<double>* tip_limits_mm = nullptr) const;
 
   /// The vertices of each end-effector (those skinned mostly to it), EndEffectors order.
   const std::vector<std::vector<int>>& fingertip_vertices() const { return fingertip_vertices_; }

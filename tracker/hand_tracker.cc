@@ -48,6 +48,7 @@ void TrackerOptions::Check() const {
   fit.Check();
   contacts.Check();
   grasp_hold.Check();
+  release.Check();
   grasp_side.Check();
   IHS_CHECK_ARG(min_hand_points >= 10, "tracker.min_hand_points must be >= 10");
   IHS_CHECK_ARG(min_data_coverage >= 0 && min_data_coverage <= 1,
@@ -147,6 +148,8 @@ void HandTracker::BuildStages() {
   contacts_ = std::make_unique<ContactDetector>(model_, options_.contacts);
   grasp_hold_ = std::make_unique<GraspHold>(options_.grasp_hold, options_.contacts.min_bones,
                                             model_.EndEffectors(), contacts_->fingertip_vertices());
+  release_watch_ =
+      std::make_unique<ReleaseWatch>(options_.release, contacts_->fingertip_vertices().size());
   thumb_vertices_.clear();
   const std::vector<int> ends = model_.EndEffectors();
   for (size_t k = 0; k < ends.size() && k < contacts_->fingertip_vertices().size(); ++k) {
@@ -428,6 +431,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
     has_previous_ = false;
     previous_contact_vertices_.clear();
     previous_contact_bones_.clear();
+    release_watch_->Reset();
     return finish();
   }
 
@@ -532,8 +536,19 @@ TrackResult HandTracker::Track(const Frame& frame) {
       if ((p.array() >= low.array()).all() && (p.array() <= high.array()).all()) near.push_back(p);
     }
     const PointKdTree object(std::move(near));
-    result.contacts = grasp_hold_->Update(contacts_->Detect(vertices, object), vertices,
-                                          pose_.cam_from_root, object);
+    // The previous frame's contact fingertips rising off together let go of the object.
+    std::vector<double> distances = contacts_->TipDistances(vertices, object);
+    std::vector<size_t> grasp;
+    const std::vector<int> ends = model_.EndEffectors();
+    for (size_t k = 0; k < ends.size(); ++k) {
+      if (std::count(previous_contact_bones_.begin(), previous_contact_bones_.end(), ends[k]))
+        grasp.push_back(k);
+    }
+    result.grasp_let_go = release_watch_->Observe(distances, grasp);
+    if (result.grasp_let_go) grasp_hold_->Release();
+    const std::vector<double> limits = release_watch_->Limits();
+    const Contacts detected = contacts_->Select(std::move(distances), &limits);
+    result.contacts = grasp_hold_->Update(detected, vertices, pose_.cam_from_root, object);
     // A pose found anew (a search) is not the previous one moved: no pairs across it; nor
     // across a thumb the thumb check moved.
     if (!previous_vertices_.empty() && result.status == TrackStatus::kTracked) {
@@ -551,6 +566,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   if (result.contacts.bones.empty() || result.status != TrackStatus::kTracked) {
     grasp_hold_->Release();
   }
+  if (!result.HasPose()) release_watch_->Reset();
   result.contacts_ms = MillisecondsSince(stage);
   previous_vertices_ = vertices;
   previous_contact_vertices_ = result.contacts.vertices;

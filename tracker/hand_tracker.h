@@ -14,6 +14,7 @@
 #include "core/frame.h"
 #include "tracker/contacts.h"
 #include "tracker/grasp_hold.h"
+#include "tracker/release_watch.h"
 #include "tracker/grasp_side.h"
 #include "tracker/hand_fit.h"
 #include "tracker/hand_model.h"
@@ -29,6 +30,7 @@ struct TrackerOptions {
   HandFitOptions fit;
   ContactOptions contacts;
   GraspHoldOptions grasp_hold;
+  ReleaseOptions release;
   /// A pose whose palm faces away from the object seen in the hand explains the frame worse
   /// (GraspSide): in the search's ranking, the tracked fit's competition with a search, and the
   /// turned-over check.
@@ -154,6 +156,9 @@ struct TrackResult {
   /// The fit turned over was tried this frame and explained the hand about as well (within
   /// TrackerOptions::flip_tie_score): the pose is doubtful.
   bool flip_tie = false;
+  /// The previous frame's grasp was let go this frame (ReleaseWatch): its fingertips do not
+  /// count as contacts until they come back.
+  bool grasp_let_go = false;
   /// The template's scale in use (1 until an estimate is made; see TrackerOptions).
   double hand_scale = 1.0;
   /// Time spent on this frame, ms: in all, and on segmentation, the pose fit (with any
@@ -257,6 +262,7 @@ class HandTracker {
   std::unique_ptr<HandFitter> initial_fitter_;
   std::unique_ptr<ContactDetector> contacts_;
   std::unique_ptr<GraspHold> grasp_hold_;
+  std::unique_ptr<ReleaseWatch> release_watch_;
   // The thumb's fingertip vertices (ContactDetector::fingertip_vertices), sorted.
   std::vector<int> thumb_vertices_;
   std::vector<std::unique_ptr<ScaleCandidate>> scale_candidates_;

@@ -10,6 +10,7 @@
 
 #include "core/point_kd_tree.h"
 #include "tracker/hand_data.h"
+#include "tracker/release_watch.h"
 
 namespace ihs::tracker {
 namespace {
@@ -171,6 +172,98 @@ TEST_F(ContactsTest, TheSurfaceContinuedUnderTheFingertipsFindsTheirContacts) {
   bad = ContactOptions();
   bad.surface_max_rms_mm = 0;
   EXPECT_THROW(ContactDetector(hand_, bad), std::invalid_argument);
+}
+
+TEST_F(ContactsTest, AFingertipsContactDistanceIsWhereItStartsToCount) {
+  const int thumb = 4, index = 3, middle = 2;
+  const Contacts contacts = Detect({{thumb, 0.3f}, {index, 7.2f}});
+  ASSERT_EQ(contacts.tip_distance_mm.size(), ends_.size());
+  EXPECT_LE(contacts.tip_distance_mm[thumb], 1.0);
+  // The index counts from its distance on: the grown threshold is the first step past it.
+  EXPECT_GT(contacts.tip_distance_mm[index], 5.0);
+  EXPECT_LE(contacts.tip_distance_mm[index], contacts.threshold_mm);
+  EXPECT_GT(contacts.tip_distance_mm[index], contacts.threshold_mm - 0.5 - 1e-9);
+  // A fingertip with no object point near it has only a far contact distance.
+  EXPECT_GT(contacts.tip_distance_mm[middle], 7.2);
+  // Limits keep a fingertip out at any threshold.
+  std::vector<double> limits(ends_.size(), kNoContactMm);
+  limits[index] = -1;
+  const Contacts limited = detector_.Select(contacts.tip_distance_mm, &limits);
+  EXPECT_FALSE(Has(limited, index));
+  EXPECT_TRUE(Has(limited, thumb));
+  EXPECT_THROW(detector_.Select({1.0, 2.0}), std::invalid_argument);
+}
+
+// The contact distances of a grasp's two fingertips (thumb 4, index 3) over frames.
+class ReleaseWatchTest : public ::testing::Test {
+ protected:
+  ReleaseWatchTest() { options_.enabled = true; }
+  static std::vector<double> Tips(double index_mm, double thumb_mm) {
+    return {30.0, 25.0, 20.0, index_mm, thumb_mm};
+  }
+  ReleaseOptions options_;
+  const std::vector<size_t> grasp_{3, 4};
+};
+
+TEST_F(ReleaseWatchTest, AGraspWhoseFingertipsRiseTogetherIsLetGoUntilTheyComeBack) {
+  ReleaseWatch watch(options_, 5);
+  // Held: the fitted fingertips wander by a millimetre or two.
+  for (double d : {2.0, 3.0, 2.5, 3.5, 2.8}) EXPECT_FALSE(watch.Observe(Tips(d, d - 1), grasp_));
+  // Let go: both rise by 7-8 mm within three frames (on the second of them by 5 or more).
+  EXPECT_FALSE(watch.Observe(Tips(5.0, 4.5), grasp_));
+  EXPECT_TRUE(watch.Observe(Tips(9.5, 8.5), grasp_));
+  std::vector<double> limits = watch.Limits();
+  EXPECT_LT(limits[3], 0);
+  EXPECT_LT(limits[4], 0);
+  EXPECT_GT(limits[0], 100);
+  // Swinging back and coming down again: out until each is within return_mm (2.5) of where it
+  // was before (2.8 / 1.8 mm).
+  for (double d : {10.0, 10.0, 9.0, 6.0}) {
+    watch.Observe(Tips(d, d), {});
+    EXPECT_LT(watch.Limits()[3], 0);
+  }
+  watch.Observe(Tips(4.5, 5.2), {});
+  EXPECT_GT(watch.Limits()[3], 100);  // 4.5 <= 2.8 + 2.5.
+  EXPECT_LT(watch.Limits()[4], 0);    // 5.2 > 1.8 + 2.5, and less than rise_mm below 10.
+  watch.Observe(Tips(3.0, 2.0), {});
+  EXPECT_GT(watch.Limits()[4], 100);
+  // A re-grasp the fit places farther off than the last grasp: back once it has come down by
+  // rise_mm from the farthest it went.
+  ReleaseWatch again(options_, 5);
+  for (double d : {2.0, 2.5, 2.0}) again.Observe(Tips(d, d), grasp_);
+  ASSERT_TRUE(again.Observe(Tips(9.0, 9.0), grasp_));
+  for (double d : {12.0, 12.0, 8.0}) again.Observe(Tips(d, d), {});
+  EXPECT_LT(again.Limits()[3], 0);
+  again.Observe(Tips(6.5, 6.5), {});
+  EXPECT_GT(again.Limits()[3], 100);
+}
+
+TEST_F(ReleaseWatchTest, OneFingertipDriftingOffWhileTheOtherHoldsIsNoRelease) {
+  ReleaseWatch watch(options_, 5);
+  double thumb = 1.0;
+  for (int frame = 0; frame < 10; ++frame, thumb += 2.0)
+    EXPECT_FALSE(watch.Observe(Tips(2.0 + 0.3 * (frame % 2), thumb), grasp_));
+  // Nor with the watch off, or with a single fingertip.
+  ReleaseOptions off;
+  ReleaseWatch idle(off, 5);
+  idle.Observe(Tips(2.0, 2.0), grasp_);
+  EXPECT_FALSE(idle.Observe(Tips(12.0, 12.0), grasp_));
+  ReleaseWatch lone(options_, 5);
+  lone.Observe(Tips(2.0, 2.0), {4});
+  EXPECT_FALSE(lone.Observe(Tips(12.0, 12.0), {4}));
+  // A let-go fingertip that never comes back counts again after max_frames.
+  ReleaseOptions brief = options_;
+  brief.max_frames = 3;
+  ReleaseWatch watch2(brief, 5);
+  watch2.Observe(Tips(2.0, 2.0), grasp_);
+  ASSERT_TRUE(watch2.Observe(Tips(12.0, 12.0), grasp_));
+  for (int frame = 0; frame < 2; ++frame) watch2.Observe(Tips(12.0, 12.0), {});
+  EXPECT_LT(watch2.Limits()[3], 0);
+  watch2.Observe(Tips(12.0, 12.0), {});
+  EXPECT_GT(watch2.Limits()[3], 100);
+  ReleaseOptions bad = options_;
+  bad.rise_mm = 0;
+  EXPECT_THROW(ReleaseWatch(bad, 5), std::invalid_argument);
 }
 
 }  // namespace
