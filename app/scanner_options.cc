@@ -113,6 +113,8 @@ void AddContactOptions(OptionRegistry& r, tracker::ContactOptions* contacts) {
         "fewest object points that make a fingertip's surface");
   r.Add("tracker.contacts.surface_max_rms_mm", &c.surface_max_rms_mm,
         "a fingertip's surface is continued only where its points lie this near it (RMS), mm");
+  r.Add("tracker.contacts.surface_trim", &c.surface_trim,
+        "continue a patch no one surface explains by the surface nearest the fingertip");
 }
 
 void AddGraspHoldOptions(OptionRegistry& r, tracker::GraspHoldOptions* hold) {

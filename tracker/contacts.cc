@@ -55,10 +55,11 @@ std::vector<float> ContactDetector::SurfaceDistances(
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();
   for (int v : tip) centre += posed_vertices[v];
   centre /= static_cast<float>(tip.size());
-  // Points that no sphere or plane explains (an edge, two surfaces) are not continued.
+  // Points that no sphere or plane explains (an edge, two surfaces) are not continued, but
+  // for the one most of them lie on with surface_trim.
   const std::optional<LocalSurface> surface =
       SurfaceAround(centre, object_points, options_.surface_patch_mm, options_.surface_min_points,
-                    options_.surface_max_rms_mm);
+                    options_.surface_max_rms_mm, options_.surface_trim);
   if (!surface) return distances;
   for (size_t i = 0; i < tip.size(); ++i) {
     distances[i] = static_cast<float>(surface->Distance(posed_vertices[tip[i]].cast<double>()));

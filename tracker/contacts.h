@@ -57,6 +57,10 @@ struct ContactOptions {
   double surface_patch_mm = 25.0;
   int surface_min_points = 15;
   double surface_max_rms_mm = 1.5;
+  /// A patch no one surface explains (a box's edge in it: 2-4.5 mm RMS around the touching
+  /// fingertips of a generated box turn) is continued by the surface nearest the fingertip
+  /// (SurfaceAround's `trim`).
+  bool surface_trim = false;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

@@ -1,6 +1,7 @@
 #include "tracker/local_surface.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 namespace ihs::tracker {
@@ -50,19 +51,48 @@ LocalSurface FitLocalSurface(const std::vector<Eigen::Vector3d>& points, double 
   return surface;
 }
 
+namespace {
+
+double Rms(const LocalSurface& surface, const std::vector<Eigen::Vector3d>& points) {
+  double sum_sq = 0;
+  for (const Eigen::Vector3d& p : points) sum_sq += std::pow(surface.Distance(p), 2);
+  return std::sqrt(sum_sq / static_cast<double>(points.size()));
+}
+
+}  // namespace
+
 std::optional<LocalSurface> SurfaceAround(const Eigen::Vector3f& centre,
                                           const std::vector<Eigen::Vector3f>& points,
-                                          double reach_mm, int min_points, double max_rms_mm) {
+                                          double reach_mm, int min_points, double max_rms_mm,
+                                          bool trim) {
   std::vector<Eigen::Vector3d> patch;
   for (const Eigen::Vector3f& p : points) {
     if ((p - centre).squaredNorm() <= reach_mm * reach_mm) patch.push_back(p.cast<double>());
   }
   if (static_cast<int>(patch.size()) < min_points) return std::nullopt;
-  const LocalSurface surface = FitLocalSurface(patch, 1000.0);
-  double sum_sq = 0;
-  for (const Eigen::Vector3d& p : patch) sum_sq += std::pow(surface.Distance(p), 2);
-  if (std::sqrt(sum_sq / static_cast<double>(patch.size())) > max_rms_mm) return std::nullopt;
-  return surface;
+  LocalSurface surface = FitLocalSurface(patch, 1000.0);
+  if (Rms(surface, patch) <= max_rms_mm) return surface;
+  if (!trim) return std::nullopt;
+  // The surface nearest the centre: fitted to the quarter of the patch nearest it, then to
+  // every point of the patch near that fit, a few times.
+  const Eigen::Vector3d c = centre.cast<double>();
+  const size_t seed = std::max<size_t>(static_cast<size_t>(min_points), patch.size() / 4);
+  std::nth_element(patch.begin(), patch.begin() + (seed - 1), patch.end(),
+                   [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+                     return (a - c).squaredNorm() < (b - c).squaredNorm();
+                   });
+  surface = FitLocalSurface(std::vector<Eigen::Vector3d>(patch.begin(), patch.begin() + seed),
+                            1000.0);
+  for (int round = 0; round < 3; ++round) {
+    std::vector<Eigen::Vector3d> near;
+    for (const Eigen::Vector3d& p : patch) {
+      if (surface.Distance(p) <= 2 * max_rms_mm) near.push_back(p);
+    }
+    if (static_cast<int>(near.size()) < min_points) return std::nullopt;
+    surface = FitLocalSurface(near, 1000.0);
+    if (Rms(surface, near) <= max_rms_mm) return surface;
+  }
+  return std::nullopt;
 }
 
 }  // namespace ihs::tracker

@@ -33,8 +33,12 @@ LocalSurface FitLocalSurface(const std::vector<Eigen::Vector3d>& points, double 
 /// The surface through the `points` within `reach_mm` of `centre` (a surface curved more
 /// gently than a 1 m sphere taken as flat), or none where fewer than `min_points` lie there
 /// or they lie farther than `max_rms_mm` (RMS) from it: a patch across an edge or two surfaces.
+/// With `trim`, such a patch gives the surface nearest `centre`: fitted to the quarter of the
+/// patch nearest it, then to the patch's points within 2 `max_rms_mm` of that fit (three times
+/// at most) — a box's face the fingertip rests on, beside the edge.
 std::optional<LocalSurface> SurfaceAround(const Eigen::Vector3f& centre,
                                           const std::vector<Eigen::Vector3f>& points,
-                                          double reach_mm, int min_points, double max_rms_mm);
+                                          double reach_mm, int min_points, double max_rms_mm,
+                                          bool trim = false);
 
 }  // namespace ihs::tracker

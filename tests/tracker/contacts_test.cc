@@ -166,6 +166,13 @@ TEST_F(ContactsTest, TheSurfaceContinuedUnderTheFingertipsFindsTheirContacts) {
   const std::vector<Eigen::Vector3f> other_step = SurfaceAtTip(index, 0.3f, 0.0f, true);
   step.insert(step.end(), other_step.begin(), other_step.end());
   EXPECT_TRUE(DetectOn(continued, step).bones.empty());
+  // With surface_trim, the face nearest each fingertip is continued: the touches are found at
+  // the first thresholds, as on the plane alone.
+  ContactOptions trimmed = surface;
+  trimmed.surface_trim = true;
+  const Contacts on_step = DetectOn(ContactDetector(hand_, trimmed), step);
+  EXPECT_TRUE(Has(on_step, thumb) && Has(on_step, index));
+  EXPECT_LE(on_step.threshold_mm, 4.0);
   ContactOptions bad;
   bad.surface_mm = -1;
   EXPECT_THROW(ContactDetector(hand_, bad), std::invalid_argument);
