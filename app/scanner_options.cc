@@ -386,6 +386,8 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
   r.Add("fusion.turn_carry.catch_up_frames", &u.turn_carry.catch_up_frames,
         "once the turn is recognised, the object catches up the hand's turn in the last this "
         "many frames nothing registered (0: none)");
+  r.Add("fusion.turn_carry.fast_back_kept_out", &u.turn_carry.fast_back_kept_out,
+        "a frame whose hand turns back faster than max_frame_turn_deg keeps its contacts out too");
   r.Add("fusion.turn_carry.recognise_max_frame_deg", &u.turn_carry.recognise_max_frame_deg,
         "a frame's turn counts at most this much towards recognising it, degrees");
   r.Add("fusion.turn_carry.max_frame_turn_deg", &u.turn_carry.max_frame_turn_deg,

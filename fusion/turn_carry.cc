@@ -63,7 +63,9 @@ HandTurn TurnCarry::Judge(const std::optional<Rigid3>& hand_motion, const Rigid3
   const Eigen::AngleAxisd step(hand_motion ? hand_motion->rotation() : Eigen::Matrix3d::Identity());
   if (!hand_motion || step.angle() > options_.max_frame_turn_deg * M_PI / 180.0) {
     along_axis_.clear();
-    return HandTurn::kUnknown;
+    const bool back = hand_motion && recognised_ && options_.fast_back_kept_out &&
+                      (step.axis() * step.angle()).dot(cam_from_object.rotation() * axis_) < 0;
+    return back ? HandTurn::kBack : HandTurn::kUnknown;
   }
   // The hand's turn in the object frame, where a turn about the object's own axis stays put.
   turn_ = cam_from_object.rotation().transpose() * (step.axis() * step.angle());

@@ -63,6 +63,11 @@ struct TurnCarryOptions {
   /// A hand that turns farther than this in one frame was refitted rather than followed (a
   /// fit that flipped, a search): its motion says nothing of the object's, degrees.
   double max_frame_turn_deg = 15.0;
+  /// Such a frame turning back once the turn is recognised is judged back all the same: its
+  /// contacts are kept out. Fitted hands swinging back to re-grasp turn 16-29° a frame, and
+  /// their contacts, used where the frame was not judged, turned 22 generated lathe and ball
+  /// turns back by 132° in all (docs/fusion.md).
+  bool fast_back_kept_out = true;
   /// The hand carries only the turn of an object whose surface leaves it free: where at least
   /// `min_free_share` of the last `surface_frames` frames whose free directions ICP judged
   /// had one (IcpResult::free_directions). Balls, bottles and the pin: all of them; boxes and

@@ -137,6 +137,26 @@ TEST(TurnCarryTest, TheTurnMissedBeforeItWasRecognisedIsCaughtUpOnce) {
   EXPECT_EQ(without.TakeCatchUp(), 0);
 }
 
+TEST(TurnCarryTest, AHandSwingingBackFasterThanAFitFollowsStillKeepsTheContactsOut) {
+  const Eigen::Vector3d axis(0, 1, 0);
+  TurnCarryOptions off;
+  off.fast_back_kept_out = false;
+  TurnCarry carry, before(off);
+  for (TurnCarry* c : {&carry, &before}) {
+    TurnFrames(c, 3, 100, true, true);
+    ASSERT_TRUE(c->recognised());
+  }
+  // 20° a frame: too fast to say how the object turned, but a swing back all the same.
+  EXPECT_EQ(carry.Judge(HandTurnBy(-20, axis), Rigid3()), HandTurn::kBack);
+  EXPECT_EQ(carry.carried_rad(), 0);
+  EXPECT_EQ(before.Judge(HandTurnBy(-20, axis), Rigid3()), HandTurn::kUnknown);
+  // Forward that fast is not carried either way, nor anything before the turn is recognised.
+  EXPECT_EQ(carry.Judge(HandTurnBy(20, axis), Rigid3()), HandTurn::kUnknown);
+  EXPECT_EQ(carry.carried_rad(), 0);
+  TurnCarry fresh;
+  EXPECT_EQ(fresh.Judge(HandTurnBy(-20, axis), Rigid3()), HandTurn::kUnknown);
+}
+
 TEST(TurnCarryTest, BackAndForthOrTurnsWithoutContactsAreNeverRecognised) {
   const Eigen::Vector3d axis(0, 1, 0);
   TurnCarry wiggled;
