@@ -68,6 +68,7 @@ class ScanRecord {
   std::int64_t turned_over_frames_ = 0;
   // Frames whose thumb the thumb check moved (tracker::TrackerOptions::thumb_check).
   std::int64_t thumb_moved_frames_ = 0;
+  // Frames whose grasp the release watch saw let go (tracker::ReleaseWatch).
   std::int64_t let_go_frames_ = 0;
   // Frames whose contacts were a grasp held without being detected (tracker::GraspHold).
   std::int64_t held_grasp_frames_ = 0;

@@ -55,8 +55,8 @@ std::vector<float> ContactDetector::SurfaceDistances(
   Eigen::Vector3f centre = Eigen::Vector3f::Zero();
   for (int v : tip) centre += posed_vertices[v];
   centre /= static_cast<float>(tip.size());
-  // Points that no sphere or plane explains (an edge, two surfaces) are not continued, but
-  // for the one most of them lie on with surface_trim.
+  // Points that no sphere or plane explains (an edge, two surfaces) are not continued (with
+  // surface_trim, by the surface nearest the fingertip).
   const std::optional<LocalSurface> surface =
       SurfaceAround(centre, object_points, options_.surface_patch_mm, options_.surface_min_points,
                     options_.surface_max_rms_mm, options_.surface_trim);

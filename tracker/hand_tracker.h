@@ -14,12 +14,12 @@
 #include "core/frame.h"
 #include "tracker/contacts.h"
 #include "tracker/grasp_hold.h"
-#include "tracker/release_watch.h"
 #include "tracker/grasp_side.h"
 #include "tracker/hand_fit.h"
 #include "tracker/hand_model.h"
 #include "tracker/hand_pose.h"
 #include "tracker/hand_search.h"
+#include "tracker/release_watch.h"
 #include "tracker/segmentation.h"
 
 namespace ihs::tracker {
