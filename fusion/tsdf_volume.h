@@ -106,14 +106,28 @@ class TsdfVolume {
     std::uint8_t rgb[3] = {0, 0, 0};
     std::uint8_t unused = 0;
   };
+  // Voxels lie in bricks of 8³ (4 KiB, x fastest inside a brick, then y, then z; the bricks in
+  // the same order): a voxel's neighbours along all three axes are mostly in its own brick, so
+  // integration and raycasting, which touch a thin shell of voxels, read a few pages instead of
+  // one per voxel row (row-major, a step in z was 512 KiB away).
+  static constexpr int kBrickShift = 3;
+  static constexpr int kBrickEdge = 1 << kBrickShift;
   std::int64_t Index(int i, int j, int k) const {
-    return (static_cast<std::int64_t>(k) * n_ + j) * n_ + i;
+    constexpr int mask = kBrickEdge - 1;
+    const std::int64_t brick =
+        (static_cast<std::int64_t>(k >> kBrickShift) * bricks_ + (j >> kBrickShift)) * bricks_ +
+        (i >> kBrickShift);
+    return (brick << (3 * kBrickShift)) |
+           (((k & mask) << (2 * kBrickShift)) | ((j & mask) << kBrickShift) | (i & mask));
   }
+  bool Sample(const Eigen::Vector3f& point, float* distance_mm) const;
   // The centre of voxel (i, j, k) in the volume frame.
   Eigen::Vector3f Centre(int i, int j, int k) const;
 
   const TsdfOptions options_;
   const int n_;
+  // Bricks per edge: n_ / kBrickEdge rounded up (the voxels past n_ are never touched).
+  const int bricks_;
   // Index bounds (inclusive) of the voxels updated so far; lo > hi while none is.
   std::array<int, 3> observed_lo_;
   std::array<int, 3> observed_hi_ = {-1, -1, -1};
@@ -123,6 +137,10 @@ class TsdfVolume {
   std::vector<Voxel, HugePageAllocator<Voxel>> voxels_;
   // Scratch for Integrate: one bit per voxel, all zero between calls.
   std::vector<std::uint64_t, HugePageAllocator<std::uint64_t>> touched_bits_;
+  // The cube's half edge, the voxel's edge (mm) and a stored distance's unit, as floats.
+  const float half_mm_;
+  const float voxel_mm_float_;
+  const float mm_per_tsdf_unit_;
 };
 
 }  // namespace ihs::fusion

@@ -187,5 +187,45 @@ TEST(TsdfVolumeTest, ClearForgetsEveryObservationAndTheVolumeFusesAnew) {
   EXPECT_EQ(volume.ExtractMesh().faces.size(), faces);
 }
 
+// Voxels lie in bricks of 8³; a cube whose edge is not a whole number of bricks keeps the voxels
+// past its edge unused. 252 voxels of the default's size sit on the same lattice as 256 (two
+// fewer at each end), so a sphere near the cube's corner, where the partial bricks are, fuses,
+// meshes, casts and clears the same in both.
+TEST(TsdfVolumeTest, ACubeThatIsNotAWholeNumberOfBricksFusesAsAWholeOneDoes) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  TsdfOptions part;
+  part.resolution = 252;
+  part.size_mm = 350.0 / 256 * 252;
+  TsdfVolume whole, partial(part);
+  ASSERT_EQ(whole.voxel_mm(), partial.voxel_mm());
+  // The sphere's far side 7 mm inside the smaller cube's corner: its band (±5.5 mm) reaches
+  // into the last, partial bricks but not past the cube.
+  const Eigen::Vector3d centre = Eigen::Vector3d::Constant(0.5 * part.size_mm - kRadius - 7);
+  const Rigid3 sphere_from_volume = Rigid3::Translation(-centre);
+  for (const Rigid3& view : test::ViewsAround(600)) {
+    const Frame frame = RenderSphere(intrinsics, view);
+    const Rigid3 cam_from_volume = view * sphere_from_volume;
+    EXPECT_EQ(partial.Integrate(frame, {}, intrinsics, cam_from_volume),
+              whole.Integrate(frame, {}, intrinsics, cam_from_volume));
+  }
+  ASSERT_GT(partial.ObservedVoxels(), 10000);
+  EXPECT_EQ(partial.ObservedVoxels(), whole.ObservedVoxels());
+  // Voxels of the last, partial bricks (the cube's last four voxels along each axis) were fused.
+  for (int a = 0; a < 3; ++a)
+    EXPECT_GT(partial.ObservedBox().max()[a], 0.5 * part.size_mm - 4 * partial.voxel_mm());
+  const TriangleMesh a = whole.ExtractMesh(), b = partial.ExtractMesh();
+  ASSERT_EQ(a.faces.size(), b.faces.size());
+  EXPECT_TRUE(b.IsWatertight());
+  EXPECT_EQ(a.vertices, b.vertices);
+  const Rigid3 look = test::ViewsAround(600)[3] * sphere_from_volume;
+  const RaycastImage ray_a = whole.Raycast(intrinsics, look), ray_b = partial.Raycast(intrinsics, look);
+  EXPECT_GT(std::count_if(ray_b.depth_mm.begin(), ray_b.depth_mm.end(), [](float d) { return d > 0; }),
+            1000);
+  EXPECT_EQ(ray_a.depth_mm, ray_b.depth_mm);
+  partial.Clear();
+  EXPECT_EQ(partial.ObservedVoxels(), 0);
+  EXPECT_TRUE(partial.ExtractMesh().Empty());
+}
+
 }  // namespace
 }  // namespace ihs::fusion
