@@ -57,10 +57,13 @@ int RemoveMeshPixels(const TriangleMesh& mesh, const Frame& frame,
     const int v1 = std::min(box_v1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}))));
     for (int v = v0; v <= v1; ++v) {
       for (int u = u0; u <= u1; ++u) {
-        // Barycentric weights of the pixel centre.
+        // Barycentric weights of the pixel centre; a weight's sign is its numerator's times the
+        // area's, so most pixels outside are told without dividing.
         const float px = u + 0.5f, py = v + 0.5f;
-        const float wa = ((b.x() - px) * (c.y() - py) - (b.y() - py) * (c.x() - px)) / area;
-        const float wb = ((c.x() - px) * (a.y() - py) - (c.y() - py) * (a.x() - px)) / area;
+        const float na = (b.x() - px) * (c.y() - py) - (b.y() - py) * (c.x() - px);
+        const float nb = (c.x() - px) * (a.y() - py) - (c.y() - py) * (a.x() - px);
+        if ((area > 0) ? (na < 0 || nb < 0) : (na > 0 || nb > 0)) continue;
+        const float wa = na / area, wb = nb / area;
         const float wc = 1.0f - wa - wb;
         if (wa < 0 || wb < 0 || wc < 0) continue;
         float& z = z_buffer[static_cast<size_t>(v - box_v0) * box_width + (u - box_u0)];

@@ -43,7 +43,11 @@ TsdfVolume::TsdfVolume(TsdfOptions options)
       touched_bits_((voxels_.size() + 63) / 64, 0),
       half_mm_(static_cast<float>(0.5 * options_.size_mm)),
       voxel_mm_float_(static_cast<float>(voxel_mm_)),
-      mm_per_tsdf_unit_(static_cast<float>(truncation_mm_) / kTsdfScale) {}
+      mm_per_tsdf_unit_(static_cast<float>(truncation_mm_) / kTsdfScale) {
+  // Computed in double, each axis on its own, then rounded: as Centre always was.
+  const double half = 0.5 * options_.size_mm;
+  for (int i = 0; i < n_; ++i) centres_.push_back(static_cast<float>(-half + (i + 0.5) * voxel_mm_));
+}
 
 void TsdfVolume::Clear() {
   // The bricks around the observed box, whole: their voxels outside it were never observed.
@@ -67,10 +71,7 @@ void TsdfVolume::Clear() {
 }
 
 Eigen::Vector3f TsdfVolume::Centre(int i, int j, int k) const {
-  const double half = 0.5 * options_.size_mm;
-  return Eigen::Vector3d(-half + (i + 0.5) * voxel_mm_, -half + (j + 0.5) * voxel_mm_,
-                         -half + (k + 0.5) * voxel_mm_)
-      .cast<float>();
+  return Eigen::Vector3f(centres_[i], centres_[j], centres_[k]);
 }
 
 Eigen::AlignedBox3f TsdfVolume::ObservedBox() const {
@@ -143,7 +144,8 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   int updated = 0;
   // In memory order (the bits' order), which the caches like far better than the rays' order.
   auto update = [&](std::int64_t index, int i, int j, int k) {
-    const Eigen::Vector3f centre = cam_rotation * Centre(i, j, k) + cam_translation;
+    const Eigen::Vector3f centre =
+        cam_rotation * Eigen::Vector3f(centres_[i], centres_[j], centres_[k]) + cam_translation;
     if (centre.z() <= 0) return;
     const float x = static_cast<float>(intrinsics.fx) * centre.x() / centre.z() +
                     static_cast<float>(intrinsics.cx);

@@ -141,6 +141,8 @@ class TsdfVolume {
   const float half_mm_;
   const float voxel_mm_float_;
   const float mm_per_tsdf_unit_;
+  // The voxels' centres along an axis (the same along each), mm.
+  std::vector<float> centres_;
 };
 
 }  // namespace ihs::fusion
