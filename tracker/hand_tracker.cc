@@ -112,6 +112,15 @@ struct HandTracker::PendingSearch {
   std::int64_t frame_index = 0;
 };
 
+struct HandTracker::PendingFlipCheck {
+  // The fit turned over and its score, on the frame the check began on.
+  std::future<std::pair<HandFitResult, double>> turned;
+  // The tracked fit's score and root there.
+  double kept_score = 0;
+  Rigid3 cam_from_root;
+  std::int64_t frame_index = 0;
+};
+
 HandTracker::HandTracker(HandModel model, const CameraIntrinsics& intrinsics,
                          TrackerOptions options)
     : base_model_(std::move(model)),
@@ -218,6 +227,7 @@ void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& f
   // (its pose is at the old scale).
   FinishSearch();
   pending_.reset();
+  pending_flip_.reset();
   pose_ = Rescaled(pose_, scale_, scale);
   has_previous_ = false;
   previous_vertices_.clear();
@@ -326,6 +336,45 @@ void HandTracker::WeighSearchBeside(const Frame& frame, TrackResult& result,
 
 void HandTracker::FinishSearch() {
   if (pending_) pending_->found.wait();
+  if (pending_flip_) pending_flip_->turned.wait();
+}
+
+void HandTracker::StartFlipCheckBeside(const Frame& frame, const TrackResult& result,
+                                       const std::optional<GraspSide>& side) {
+  auto pending = std::make_unique<PendingFlipCheck>();
+  pending->kept_score = Score(result.fit, side ? &*side : nullptr);
+  pending->cam_from_root = result.fit.pose.cam_from_root;
+  pending->frame_index = frame.index;
+  pending->turned = std::async(
+      std::launch::async, [this, start = TurnedOver(model_, result.fit.pose), frame = frame,
+                           segmentation = result.segmentation, side = side]() {
+        HandFitResult turned =
+            initial_fitter_->Fit(segmentation.hand_points, &frame, start, &segmentation);
+        const double score = Score(turned, side ? &*side : nullptr);
+        return std::make_pair(std::move(turned), score);
+      });
+  pending_flip_ = std::move(pending);
+}
+
+void HandTracker::WeighFlipCheckBeside(const Frame& frame, TrackResult& result,
+                                       const GraspSide* side) {
+  const std::unique_ptr<PendingFlipCheck> pending = std::move(pending_flip_);
+  auto [turned, other] = pending->turned.get();
+  spdlog::debug("frame {}: on frame {} the fit scored {:.2f}, turned over {:.2f}", frame.index,
+                pending->frame_index, pending->kept_score, other);
+  result.flip_tie = std::abs(other - pending->kept_score) < options_.flip_tie_score;
+  if (!(other < pending->kept_score)) return;
+  // The fit turned over, moved on as the tracked root moved since.
+  HandPose start = turned.pose;
+  start.cam_from_root =
+      result.fit.pose.cam_from_root * pending->cam_from_root.Inverse() * turned.pose.cam_from_root;
+  HandFitResult fit =
+      initial_fitter_->Fit(result.segmentation.hand_points, &frame, start, &result.segmentation);
+  if (Score(fit, side) < Score(result.fit, side)) {
+    result.fit = std::move(fit);
+    result.status = TrackStatus::kInitialised;
+    result.turned_over = true;
+  }
 }
 
 bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points,
@@ -460,6 +509,10 @@ TrackResult HandTracker::Track(const Frame& frame) {
         pending_->found.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
       WeighSearchBeside(frame, result, side());
     }
+    if (pending_flip_ &&
+        pending_flip_->turned.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+      WeighFlipCheckBeside(frame, result, side());
+    }
   }
   // A run of doubtful fits: search for the hand anew, the tracked fit competing (here, or beside
   // the tracking from the next frames on).
@@ -487,7 +540,12 @@ TrackResult HandTracker::Track(const Frame& frame) {
       (result.status == TrackStatus::kInitialised ||
        ++frames_since_flip_check_ >= options_.flip_check_frames)) {
     frames_since_flip_check_ = 0;
-    tie = CheckTurnedOver(points, frame, result, side());
+    if (options_.search_beside && result.status == TrackStatus::kTracked) {
+      side();  // Finds the held object (`held`) once.
+      if (!pending_flip_) StartFlipCheckBeside(frame, result, held);
+    } else {
+      tie = CheckTurnedOver(points, frame, result, side());
+    }
     thumb_moved = options_.thumb_check && CheckThumb(points, frame, result, side());
   }
   if (result.fit.data_coverage >= options_.search_data_coverage && !tie) {

@@ -99,7 +99,11 @@ struct TrackerOptions {
   /// For live input (the pipeline turns it on for a live source): a search stalls the tracker
   /// for 0.3-0.7 s, the frames arriving meanwhile are dropped, and the next frame, far from the
   /// last fit, starts another search. Off, the same frames always give the same hands. The
-  /// first search (no pose yet) always runs in place.
+  /// first search (no pose yet) always runs in place. The periodic check of the fit turned
+  /// over (flip_check_frames) runs beside too: the fit turned over on the frame it was due,
+  /// weighed there against the tracked fit, and where it won, moved on and fitted on the
+  /// newest frame as a search's pose is (a check in place added 20-35 ms to every tenth
+  /// frame's latency). A fit found by a search is still checked in place.
   bool search_beside = false;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -193,7 +197,10 @@ class HandTracker {
 
   /// Whether a search runs beside the tracking (TrackerOptions::search_beside).
   bool searching() const { return pending_ != nullptr; }
-  /// Waits until a search running beside the tracking is done; the next Track weighs its pose.
+  /// Whether a check of the fit turned over runs beside the tracking (search_beside).
+  bool checking_flip() const { return pending_flip_ != nullptr; }
+  /// Waits until a search (and a check of the fit turned over) running beside the tracking is
+  /// done; the next Track weighs its pose.
   void FinishSearch();
 
   /// The template at its current scale (it changes once, when the scale estimate is made).
@@ -209,6 +216,7 @@ class HandTracker {
  private:
   struct ScaleCandidate;
   struct PendingSearch;
+  struct PendingFlipCheck;
   // What a search places: the open hand and its curls, and the poses the tracker holds.
   struct SearchStarts {
     std::vector<HandPose> articulations, tracked;
@@ -226,6 +234,14 @@ class HandTracker {
   // A finished search's pose, moved on and fitted on this frame, replaces `result`'s fit where
   // it explains the hand better.
   void WeighSearchBeside(const Frame& frame, TrackResult& result, const GraspSide* side);
+  // Starts the check of the fit turned over (CheckTurnedOver) beside the tracking, on copies
+  // of this frame's data.
+  void StartFlipCheckBeside(const Frame& frame, const TrackResult& result,
+                            const std::optional<GraspSide>& side);
+  // A finished check beside: where the fit turned over explained its frame better, it is moved
+  // on, fitted on this frame and replaces `result`'s fit where it explains the hand better;
+  // a tie on its frame makes this one doubtful.
+  void WeighFlipCheckBeside(const Frame& frame, TrackResult& result, const GraspSide* side);
   // How badly `fit` explains the frame (lower is better): FitScore, and the grasp side's
   // penalty where an object is seen in the hand.
   double Score(const HandFitResult& fit, const GraspSide* side) const;
@@ -280,9 +296,10 @@ class HandTracker {
   std::vector<Eigen::Vector3f> previous_vertices_;
   std::vector<int> previous_contact_vertices_;
   std::vector<int> previous_contact_bones_;
-  // A search running beside the tracking; last, so that it is waited for before the stages it
-  // uses go.
+  // A search and a check of the fit turned over running beside the tracking; last, so that
+  // they are waited for before the stages they use go.
   std::unique_ptr<PendingSearch> pending_;
+  std::unique_ptr<PendingFlipCheck> pending_flip_;
 };
 
 }  // namespace ihs::tracker

@@ -238,9 +238,12 @@ TEST(HandTrackerTest, AFitTurnedOverMidSequenceIsDoubtedAndTurnedBackWithinAFewF
     int last_over = -1;               // The last of them.
     bool trusted_while_over = false;  // A turned-over pose given as tracked, undoubted.
   };
-  auto run = [&](bool recover) {
+  // `beside`: the search and the flip check run beside the tracking, as live (each waited for
+  // after its frame, so that the next frame weighs it: the run is the same every time).
+  auto run = [&](bool recover, bool beside = false) {
     TrackerOptions options;
     options.scale_frames = 0;
+    options.search_beside = beside;
     if (!recover) options.flip_check_frames = 0, options.doubtful_frames_to_search = 1000;
     HandTracker tracker(renderer.hand(), renderer.options().intrinsics, options);
     tracker.Initialise(FitPoseToJoints(renderer.hand(), renderer.Render(0).joints_mm));
@@ -252,15 +255,16 @@ TEST(HandTrackerTest, AFitTurnedOverMidSequenceIsDoubtedAndTurnedBackWithinAFewF
             TurnedOver(renderer.hand(), FitPoseToJoints(renderer.hand(), rendered.joints_mm)));
       }
       const TrackResult result = tracker.Track(rendered.frame);
+      if (beside) tracker.FinishSearch();
       if (!result.HasPose() ||
           CompareHandSides(renderer.hand(), result.joints_mm, rendered.joints_mm).turned_over()) {
         ++outcome.over, outcome.last_over = i;
         outcome.trusted_while_over |= result.HasPose() && !result.doubtful;
       }
     }
-    std::printf("%s: %d frames turned over or lost, the last %d\n",
-                recover ? "searching and checking the flip" : "neither", outcome.over,
-                outcome.last_over);
+    std::printf("%s%s: %d frames turned over or lost, the last %d\n",
+                recover ? "searching and checking the flip" : "neither",
+                beside ? " beside the tracking" : "", outcome.over, outcome.last_over);
     return outcome;
   };
   const Outcome recovered = run(true);
@@ -268,8 +272,53 @@ TEST(HandTrackerTest, AFitTurnedOverMidSequenceIsDoubtedAndTurnedBackWithinAFewF
   EXPECT_LE(recovered.over, within);
   EXPECT_LT(recovered.last_over, 12 + within);
   EXPECT_FALSE(recovered.trusted_while_over);
+  // Beside the tracking, a frame later at most.
+  const Outcome beside = run(true, true);
+  EXPECT_LE(beside.over, within + 1);
+  EXPECT_LT(beside.last_over, 12 + within + 1);
+  EXPECT_FALSE(beside.trusted_while_over);
   // Neither searching nor checking, the fit stays turned over, or lost, for the rest.
   EXPECT_GT(run(false).over, (renderer.frame_count() - 12) / 2);
+}
+
+TEST(HandTrackerTest, TheFlipCheckBesideTheTrackingLeavesItsFrameAndIsWeighedOnTheNext) {
+  // Live (search_beside), the periodic check of the fit turned over runs on its own thread: the
+  // frame it is due on is not held up, the next frame weighs it. Tracked from the truth, the
+  // turned-over fit never wins, so the hands are the same as with the check in place.
+  synth::SequenceOptions sequence;
+  sequence.scripted.frames = 12;
+  sequence.scripted.turns = 0.05;
+  synth::SequenceRenderer renderer(sequence);
+  struct Run {
+    std::vector<std::vector<Eigen::Vector3d>> joints;
+    std::vector<int> started, weighed;  // Frames a check began on beside, and was weighed on.
+  };
+  auto run = [&](bool beside) {
+    TrackerOptions options;
+    options.scale_frames = 0;
+    options.flip_check_frames = 3;
+    options.search_beside = beside;
+    HandTracker tracker(renderer.hand(), renderer.options().intrinsics, options);
+    tracker.Initialise(FitPoseToJoints(renderer.hand(), renderer.Render(0).joints_mm));
+    Run out;
+    for (int i = 0; i < renderer.frame_count(); ++i) {
+      const bool was_checking = tracker.checking_flip();
+      const TrackResult result = tracker.Track(renderer.Render(i).frame);
+      EXPECT_EQ(result.status, TrackStatus::kTracked) << "frame " << i;
+      EXPECT_FALSE(result.turned_over) << "frame " << i;
+      if (!was_checking && tracker.checking_flip()) out.started.push_back(i);
+      if (was_checking && !tracker.checking_flip()) out.weighed.push_back(i);
+      tracker.FinishSearch();  // The next frame weighs it: the run is the same every time.
+      out.joints.push_back(result.joints_mm);
+    }
+    return out;
+  };
+  const Run in_place = run(false), beside = run(true);
+  EXPECT_TRUE(in_place.started.empty());
+  ASSERT_EQ(beside.started, (std::vector<int>{2, 5, 8, 11}));  // The last one never weighed.
+  EXPECT_EQ(beside.weighed, (std::vector<int>{3, 6, 9}));
+  for (int i = 0; i < renderer.frame_count(); ++i)
+    EXPECT_EQ(in_place.joints[i], beside.joints[i]) << "frame " << i;
 }
 
 }  // namespace
