@@ -184,18 +184,46 @@ HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) con
 }
 
 void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& frame) {
+  std::vector<HandPose> starts;
+  for (const auto& candidate : scale_candidates_)
+    starts.push_back(Rescaled(pose_, scale_, candidate->scale));
+  FitScaleCandidates(segmentation, frame, starts);
+  if (++scale_frames_done_ >= options_.scale_frames) FinishScaleEstimate();
+}
+
+void HandTracker::EstimateScaleBeside(const Segmentation& segmentation, const Frame& frame) {
+  if (pending_scale_.valid()) {
+    if (pending_scale_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    pending_scale_.get();
+    if (++scale_frames_done_ >= options_.scale_frames) {
+      FinishScaleEstimate();
+      return;
+    }
+  }
+  std::vector<HandPose> starts;
+  for (const auto& candidate : scale_candidates_)
+    starts.push_back(Rescaled(pose_, scale_, candidate->scale));
+  pending_scale_ = std::async(std::launch::async, [this, segmentation = segmentation, frame = frame,
+                                                   starts = std::move(starts)]() {
+    FitScaleCandidates(segmentation, frame, starts);
+  });
+}
+
+void HandTracker::FitScaleCandidates(const Segmentation& segmentation, const Frame& frame,
+                                     const std::vector<HandPose>& starts) {
   // Each scale's fit is its own (on the search's threads: the first frames cost several fits).
   ParallelRuns(scale_candidates_.size(), options_.search.threads, [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
       ScaleCandidate& candidate = *scale_candidates_[k];
       const HandFitResult fit =
-          candidate.fitter->Fit(segmentation.hand_points, &frame,
-                                Rescaled(pose_, scale_, candidate.scale), &segmentation);
+          candidate.fitter->Fit(segmentation.hand_points, &frame, starts[k], &segmentation);
       // How far the hand points are from the model, and the model's visible points from them.
       candidate.score += fit.data_error_mm + fit.model_error_mm;
     }
   });
-  if (++scale_frames_done_ < options_.scale_frames) return;
+}
+
+void HandTracker::FinishScaleEstimate() {
   size_t best = 0;
   for (size_t k = 1; k < scale_candidates_.size(); ++k) {
     if (scale_candidates_[k]->score < scale_candidates_[best]->score) best = k;
@@ -337,6 +365,7 @@ void HandTracker::WeighSearchBeside(const Frame& frame, TrackResult& result,
 void HandTracker::FinishSearch() {
   if (pending_) pending_->found.wait();
   if (pending_flip_) pending_flip_->turned.wait();
+  if (pending_scale_.valid()) pending_scale_.wait();
 }
 
 void HandTracker::StartFlipCheckBeside(const Frame& frame, const TrackResult& result,
@@ -565,7 +594,13 @@ TrackResult HandTracker::Track(const Frame& frame) {
   has_previous_ = has_pose_ && result.status == TrackStatus::kTracked;
   pose_ = result.fit.pose;
   has_pose_ = true;
-  if (estimating_scale() && result.HasPose()) EstimateScale(result.segmentation, frame);
+  if (estimating_scale() && result.HasPose()) {
+    if (options_.search_beside) {
+      EstimateScaleBeside(result.segmentation, frame);
+    } else {
+      EstimateScale(result.segmentation, frame);
+    }
+  }
   result.fit_ms = MillisecondsSince(stage);
   stage = SteadyClock::now();
   result.hand_scale = scale_;

@@ -5,6 +5,7 @@
 // Track(frame).
 
 #include <Eigen/Core>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -103,7 +104,10 @@ struct TrackerOptions {
   /// over (flip_check_frames) runs beside too: the fit turned over on the frame it was due,
   /// weighed there against the tracked fit, and where it won, moved on and fitted on the
   /// newest frame as a search's pose is (a check in place added 20-35 ms to every tenth
-  /// frame's latency). A fit found by a search is still checked in place.
+  /// frame's latency). A fit found by a search is still checked in place. So do the scale
+  /// estimate's fits (scale_frames): each frame's on a copy while the tracker goes on at the
+  /// template's size, a frame that comes while they run left out of the estimate, the switch
+  /// made on the frame after the last one's fits are done.
   bool search_beside = false;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -199,8 +203,8 @@ class HandTracker {
   bool searching() const { return pending_ != nullptr; }
   /// Whether a check of the fit turned over runs beside the tracking (search_beside).
   bool checking_flip() const { return pending_flip_ != nullptr; }
-  /// Waits until a search (and a check of the fit turned over) running beside the tracking is
-  /// done; the next Track weighs its pose.
+  /// Waits until a search (and a check of the fit turned over, and a frame of the scale
+  /// estimate) running beside the tracking is done; the next Track weighs its pose.
   void FinishSearch();
 
   /// The template at its current scale (it changes once, when the scale estimate is made).
@@ -264,6 +268,14 @@ class HandTracker {
   HandPose Rescaled(const HandPose& pose, double from, double to) const;
   // One frame of the scale estimate; switches to the estimated scale after the last frame.
   void EstimateScale(const Segmentation& segmentation, const Frame& frame);
+  // The same beside the tracking (search_beside): weighs the last frame's fits when they are
+  // done, then starts this frame's (or leaves this frame out while they run).
+  void EstimateScaleBeside(const Segmentation& segmentation, const Frame& frame);
+  // Each candidate scale fitted on a frame, its score added to the candidate's.
+  void FitScaleCandidates(const Segmentation& segmentation, const Frame& frame,
+                          const std::vector<HandPose>& starts);
+  // The scale the candidates' scores give; the stages rebuilt for it.
+  void FinishScaleEstimate();
 
   const HandModel base_model_;
   const bool right_hand_;
@@ -300,6 +312,8 @@ class HandTracker {
   // they are waited for before the stages they use go.
   std::unique_ptr<PendingSearch> pending_;
   std::unique_ptr<PendingFlipCheck> pending_flip_;
+  // A frame's scale candidates being fitted beside the tracking.
+  std::future<void> pending_scale_;
 };
 
 }  // namespace ihs::tracker

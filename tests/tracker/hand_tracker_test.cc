@@ -150,6 +150,35 @@ TEST(HandTrackerTest, EstimatesTheHandsScaleOverTheFirstFrames) {
   }
 }
 
+TEST(HandTrackerTest, TheScaleEstimateBesideTheTrackingGivesTheSameScaleAFrameLater) {
+  // Live (search_beside), each frame's fits at the candidate scales run on their own thread
+  // while the tracker goes on at the template's size: waited for after each frame (so that each
+  // is weighed on the next), the estimate is the one made in place, switched to a frame later.
+  if (test::HandDataDir().empty()) GTEST_SKIP() << "../shared/data is absent";
+  synth::SequenceRenderer renderer(RecordedSphere(45));
+  const HandModel model = renderer.hand().Scaled(1.08);
+  auto run = [&](bool beside, int* switched_at) {
+    TrackerOptions options;
+    options.search_beside = beside;
+    HandTracker tracker(model, renderer.options().intrinsics, options);
+    tracker.Initialise(FitPoseToJoints(model, renderer.Render(0).joints_mm));
+    for (int i = 0; i < 13 && tracker.estimating_scale(); ++i) {
+      tracker.Track(renderer.Render(i).frame);
+      tracker.FinishSearch();
+      *switched_at = i;
+    }
+    EXPECT_FALSE(tracker.estimating_scale());
+    return tracker.scale();
+  };
+  int in_place_at = -1, beside_at = -1;
+  const double in_place = run(false, &in_place_at), beside = run(true, &beside_at);
+  std::printf("scale %.4f at frame %d in place, %.4f at frame %d beside\n", in_place,
+              in_place_at, beside, beside_at);
+  EXPECT_EQ(beside, in_place);
+  EXPECT_EQ(in_place_at, TrackerOptions().scale_frames - 1);
+  EXPECT_EQ(beside_at, in_place_at + 1);
+}
+
 // An injected jump: the pose of `rendered`'s hand 80 mm and 40° away, as a tracker may come to
 // believe it.
 HandPose JumpedPose(const HandModel& hand, const synth::RenderedFrame& rendered) {
