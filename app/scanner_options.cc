@@ -140,8 +140,7 @@ void AddReleaseOptions(OptionRegistry& r, tracker::ReleaseOptions* release) {
         "how far every fingertip of the grasp rises when it lets go, mm");
   r.Add("tracker.release.return_mm", &o.return_mm,
         "a let-go fingertip counts again within this of where it was before, mm");
-  r.Add("tracker.release.max_frames", &o.max_frames,
-        "frames a fingertip stays let go at most");
+  r.Add("tracker.release.max_frames", &o.max_frames, "frames a fingertip stays let go at most");
 }
 
 void AddGraspSideOptions(OptionRegistry& r, tracker::GraspSideOptions* side) {
@@ -458,8 +457,8 @@ void AddPipelineOptions(OptionRegistry& r, PipelineOptions* options) {
         "write a preview image every this many fused frames (0: never)");
   r.Add("pipeline.max_frames", &p.max_frames, "stop after this many frames (0: all)");
   r.Add("pipeline.live_search_beside", &p.live_search_beside,
-        "from a live source, the tracker's searches and its periodic check of the fit turned "
-        "over run beside its tracking instead of stalling it");
+        "from a live source, the tracker's searches, its periodic check of the fit turned over "
+        "and its scale estimate's fits run beside its tracking instead of stalling it");
   r.Add("pipeline.stop_grace_s", &p.stop_grace_s,
         "seconds the frames in hand get after a stop before a stage still busy is left behind "
         "and the model so far is exported without them (exit 5)");

@@ -55,9 +55,10 @@ struct PipelineOptions {
   int preview_every = 30;
   /// Frames the capture thread reads at most (0: all).
   int max_frames = 0;
-  /// From a live source, the hand tracker's searches and its periodic check of the fit turned
-  /// over run beside its tracking (TrackerOptions::search_beside): they no longer stall the
-  /// tracker while the camera's frames are dropped or wait. Unpaced replays search in place whatever this says (repeatable).
+  /// From a live source, the hand tracker's searches, its periodic check of the fit turned over
+  /// and its scale estimate's fits run beside its tracking (TrackerOptions::search_beside): they
+  /// no longer stall the tracker while the camera's frames are dropped or wait. Unpaced replays
+  /// do them in place whatever this says (repeatable).
   bool live_search_beside = true;
   /// After a stop, the frames in hand get this long, seconds (a frame takes well under one; a
   /// sanitizer build's several). A stage still busy then (a source read or a fit that does not

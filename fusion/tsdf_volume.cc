@@ -46,7 +46,8 @@ TsdfVolume::TsdfVolume(TsdfOptions options)
       mm_per_tsdf_unit_(static_cast<float>(truncation_mm_) / kTsdfScale) {
   // Computed in double, each axis on its own, then rounded: as Centre always was.
   const double half = 0.5 * options_.size_mm;
-  for (int i = 0; i < n_; ++i) centres_.push_back(static_cast<float>(-half + (i + 0.5) * voxel_mm_));
+  for (int i = 0; i < n_; ++i)
+    centres_.push_back(static_cast<float>(-half + (i + 0.5) * voxel_mm_));
 }
 
 void TsdfVolume::Clear() {
@@ -191,8 +192,8 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
     const std::int64_t brick = w / layers;
     const int i0 = static_cast<int>(brick % bricks_) << kBrickShift;
     const int j0 = static_cast<int>((brick / bricks_) % bricks_) << kBrickShift;
-    const int k = (static_cast<int>(brick / bricks_ / bricks_) << kBrickShift) +
-                  static_cast<int>(w % layers);
+    const int k =
+        (static_cast<int>(brick / bricks_ / bricks_) << kBrickShift) + static_cast<int>(w % layers);
     for (; bits != 0; bits &= bits - 1) {
       const int bit = std::countr_zero(bits);
       update(w * 64 + bit, i0 + (bit & in_brick), j0 + (bit >> kBrickShift), k);
@@ -217,7 +218,8 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   constexpr int last = kBrickEdge - 1;
   const std::int64_t brick_voxels = std::int64_t{1} << (3 * kBrickShift);
   const std::int64_t dx = (i & last) != last ? 1 : brick_voxels - last;
-  const std::int64_t dy = (j & last) != last ? kBrickEdge : bricks_ * brick_voxels - last * kBrickEdge;
+  const std::int64_t dy =
+      (j & last) != last ? kBrickEdge : bricks_ * brick_voxels - last * kBrickEdge;
   const std::int64_t dz = (k & last) != last ? kBrickEdge * kBrickEdge
                                              : std::int64_t{bricks_} * bricks_ * brick_voxels -
                                                    last * kBrickEdge * kBrickEdge;

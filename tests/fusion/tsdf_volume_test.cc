@@ -218,9 +218,11 @@ TEST(TsdfVolumeTest, ACubeThatIsNotAWholeNumberOfBricksFusesAsAWholeOneDoes) {
   EXPECT_TRUE(b.IsWatertight());
   EXPECT_EQ(a.vertices, b.vertices);
   const Rigid3 look = test::ViewsAround(600)[3] * sphere_from_volume;
-  const RaycastImage ray_a = whole.Raycast(intrinsics, look), ray_b = partial.Raycast(intrinsics, look);
-  EXPECT_GT(std::count_if(ray_b.depth_mm.begin(), ray_b.depth_mm.end(), [](float d) { return d > 0; }),
-            1000);
+  const RaycastImage ray_a = whole.Raycast(intrinsics, look),
+                     ray_b = partial.Raycast(intrinsics, look);
+  EXPECT_GT(
+      std::count_if(ray_b.depth_mm.begin(), ray_b.depth_mm.end(), [](float d) { return d > 0; }),
+      1000);
   EXPECT_EQ(ray_a.depth_mm, ray_b.depth_mm);
   partial.Clear();
   EXPECT_EQ(partial.ObservedVoxels(), 0);

@@ -172,8 +172,8 @@ TEST(HandTrackerTest, TheScaleEstimateBesideTheTrackingGivesTheSameScaleAFrameLa
   };
   int in_place_at = -1, beside_at = -1;
   const double in_place = run(false, &in_place_at), beside = run(true, &beside_at);
-  std::printf("scale %.4f at frame %d in place, %.4f at frame %d beside\n", in_place,
-              in_place_at, beside, beside_at);
+  std::printf("scale %.4f at frame %d in place, %.4f at frame %d beside\n", in_place, in_place_at,
+              beside, beside_at);
   EXPECT_EQ(beside, in_place);
   EXPECT_EQ(in_place_at, TrackerOptions().scale_frames - 1);
   EXPECT_EQ(beside_at, in_place_at + 1);
