@@ -183,11 +183,15 @@ HandPose HandTracker::Rescaled(const HandPose& pose, double from, double to) con
   return out;
 }
 
-void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& frame) {
+std::vector<HandPose> HandTracker::ScaleStarts() const {
   std::vector<HandPose> starts;
   for (const auto& candidate : scale_candidates_)
     starts.push_back(Rescaled(pose_, scale_, candidate->scale));
-  FitScaleCandidates(segmentation, frame, starts);
+  return starts;
+}
+
+void HandTracker::EstimateScale(const Segmentation& segmentation, const Frame& frame) {
+  FitScaleCandidates(segmentation, frame, ScaleStarts());
   if (++scale_frames_done_ >= options_.scale_frames) FinishScaleEstimate();
 }
 
@@ -200,11 +204,8 @@ void HandTracker::EstimateScaleBeside(const Segmentation& segmentation, const Fr
       return;
     }
   }
-  std::vector<HandPose> starts;
-  for (const auto& candidate : scale_candidates_)
-    starts.push_back(Rescaled(pose_, scale_, candidate->scale));
   pending_scale_ = std::async(std::launch::async, [this, segmentation = segmentation, frame = frame,
-                                                   starts = std::move(starts)]() {
+                                                   starts = ScaleStarts()]() {
     FitScaleCandidates(segmentation, frame, starts);
   });
 }
@@ -348,18 +349,24 @@ void HandTracker::WeighSearchBeside(const Frame& frame, TrackResult& result,
   const std::unique_ptr<PendingSearch> pending = std::move(pending_);
   HandFitResult found = pending->found.get();
   if (found.data_points == 0) return;  // No hand points: nothing was found.
-  // Where the search found the hand, moved on as the tracked root moved since.
-  HandPose start = found.pose;
-  start.cam_from_root =
-      result.fit.pose.cam_from_root * pending->cam_from_root.Inverse() * found.pose.cam_from_root;
+  TakeMovedOn("the search", found.pose, pending->cam_from_root, pending->frame_index, frame, result,
+              side);
+}
+
+bool HandTracker::TakeMovedOn(const char* what, const HandPose& found, const Rigid3& then_root,
+                              std::int64_t then_frame, const Frame& frame, TrackResult& result,
+                              const GraspSide* side) const {
+  // Moved on as the tracked root moved since.
+  HandPose start = found;
+  start.cam_from_root = result.fit.pose.cam_from_root * then_root.Inverse() * found.cam_from_root;
   HandFitResult fit =
       initial_fitter_->Fit(result.segmentation.hand_points, &frame, start, &result.segmentation);
-  spdlog::debug("frame {}: the search begun at frame {} scores {:.2f}, the tracked fit {:.2f}",
-                frame.index, pending->frame_index, Score(fit, side), Score(result.fit, side));
-  if (Score(fit, side) < Score(result.fit, side)) {
-    result.fit = std::move(fit);
-    result.status = TrackStatus::kInitialised;
-  }
+  spdlog::debug("frame {}: {} begun at frame {} scores {:.2f}, the tracked fit {:.2f}", frame.index,
+                what, then_frame, Score(fit, side), Score(result.fit, side));
+  if (!(Score(fit, side) < Score(result.fit, side))) return false;
+  result.fit = std::move(fit);
+  result.status = TrackStatus::kInitialised;
+  return true;
 }
 
 void HandTracker::FinishSearch() {
@@ -393,17 +400,8 @@ void HandTracker::WeighFlipCheckBeside(const Frame& frame, TrackResult& result,
                 pending->frame_index, pending->kept_score, other);
   result.flip_tie = std::abs(other - pending->kept_score) < options_.flip_tie_score;
   if (!(other < pending->kept_score)) return;
-  // The fit turned over, moved on as the tracked root moved since.
-  HandPose start = turned.pose;
-  start.cam_from_root =
-      result.fit.pose.cam_from_root * pending->cam_from_root.Inverse() * turned.pose.cam_from_root;
-  HandFitResult fit =
-      initial_fitter_->Fit(result.segmentation.hand_points, &frame, start, &result.segmentation);
-  if (Score(fit, side) < Score(result.fit, side)) {
-    result.fit = std::move(fit);
-    result.status = TrackStatus::kInitialised;
-    result.turned_over = true;
-  }
+  result.turned_over = TakeMovedOn("the fit turned over", turned.pose, pending->cam_from_root,
+                                   pending->frame_index, frame, result, side);
 }
 
 bool HandTracker::CheckTurnedOver(const std::vector<Eigen::Vector3f>& hand_points,

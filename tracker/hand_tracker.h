@@ -246,6 +246,12 @@ class HandTracker {
   // on, fitted on this frame and replaces `result`'s fit where it explains the hand better;
   // a tie on its frame makes this one doubtful.
   void WeighFlipCheckBeside(const Frame& frame, TrackResult& result, const GraspSide* side);
+  // `found` (`what` found it on frame `then_frame`, where the tracked root was `then_root`),
+  // moved on as the tracked root moved since and fitted on this frame: replaces `result`'s fit
+  // where it explains the hand better (returns whether it did).
+  bool TakeMovedOn(const char* what, const HandPose& found, const Rigid3& then_root,
+                   std::int64_t then_frame, const Frame& frame, TrackResult& result,
+                   const GraspSide* side) const;
   // How badly `fit` explains the frame (lower is better): FitScore, and the grasp side's
   // penalty where an object is seen in the hand.
   double Score(const HandFitResult& fit, const GraspSide* side) const;
@@ -271,6 +277,8 @@ class HandTracker {
   // The same beside the tracking (search_beside): weighs the last frame's fits when they are
   // done, then starts this frame's (or leaves this frame out while they run).
   void EstimateScaleBeside(const Segmentation& segmentation, const Frame& frame);
+  // The pose to fit each candidate scale from: the current one, carried over to its scale.
+  std::vector<HandPose> ScaleStarts() const;
   // Each candidate scale fitted on a frame, its score added to the candidate's.
   void FitScaleCandidates(const Segmentation& segmentation, const Frame& frame,
                           const std::vector<HandPose>& starts);
