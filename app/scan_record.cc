@@ -88,6 +88,8 @@ void ScanRecord::Add(const FramePacket& packet) {
     entry["coverage"] = fused.coverage;
     coverage_ = fused.coverage;
     entry["anchored_contacts"] = fused.anchored_contacts;
+    entry["anchored_features"] = fused.anchored_features;
+    entry["features_moving_back"] = fused.features_moving_back;
     entry["model_contacts"] = fused.model_contacts;
     entry["icp_anchors"] = fused.icp_anchors;
     entry["contact_residual_mm"] = fused.contact_residual_mm;

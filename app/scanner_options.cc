@@ -322,6 +322,9 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
 void AddFeatureOptions(OptionRegistry& r, fusion::SiftOptions* sift, fusion::ShotOptions* shot) {
   r.Add("features.sift.max_features", &sift->max_features, "SIFT keypoints per frame");
   r.Add("features.sift.ratio", &sift->ratio, "Lowe's ratio test for SIFT matches");
+  r.Add("features.sift.support_inside", &sift->support_inside,
+        "share of a keypoint's neighbourhood radius that must lie on the object (0: any "
+        "keypoint on it)");
   r.Add("features.shot.resolution_mm", &shot->resolution_mm,
         "voxel size of the cloud ISS3D + CSHOT work on, mm");
   r.Add("features.shot.normal_radius", &shot->normal_radius, "normal radius, in resolutions");
@@ -342,6 +345,13 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
   r.Add("fusion.predict_moving", &u.predict_moving,
         "where nothing registers a frame, the object moves on as in the last frame (when the "
         "surface left no direction free there; off by default)");
+  r.Add("fusion.drop_features_moving_back", &u.drop_features_moving_back,
+        "where the hand swings back, feature pairs moving with it are left out");
+  r.Add("fusion.free_turn_min_visual_inliers", &u.free_turn_min_visual_inliers,
+        "where the surface leaves a turn free, a feature set needs this many inliers");
+  r.Add("fusion.free_turn_visual_prior_deg", &u.free_turn_visual_prior_deg,
+        "where the surface leaves a turn free, the features' turn is shrunk with this prior per "
+        "frame, degrees (0: kept as fitted)");
   r.Add("fusion.min_object_points", &u.min_object_points, "object points a frame needs");
   r.Add("fusion.loose_contact_mm", &u.loose_contact_mm,
         "contacts found farther from the object are used only where its surface leaves a turn "
@@ -356,7 +366,10 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "contacts' disagreement at which they hold icp.anchor_share in ICP (scaled by "
         "1/disagreement^2; 0: fixed share), mm");
   r.Add("fusion.anchor_slip_mm", &u.anchor_slip_mm,
-        "a contact farther than this from its anchor has slipped, mm");
+        "a contact or feature farther than this from its anchor has slipped, mm");
+  r.Add("fusion.anchor_features", &u.anchor_features,
+        "visual features tracked over frames are anchored at one object point (off: matched "
+        "frame to frame only)");
   r.Add("fusion.icp_contacts_need_spread", &u.icp_contacts_need_spread,
         "contacts hold ICP only when spread like pairwise.min_contact_spread_mm asks (off: one "
         "fingertip's patch holds it too, in the directions the surface leaves free)");

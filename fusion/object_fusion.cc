@@ -41,6 +41,9 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
   IHS_CHECK_ARG(anchor_slip_mm > 0, "fusion.anchor_slip_mm must be positive");
+  IHS_CHECK_ARG(free_turn_min_visual_inliers >= 3,
+                "fusion.free_turn_min_visual_inliers must be at least 3");
+  IHS_CHECK_ARG(free_turn_visual_prior_deg >= 0, "fusion.free_turn_visual_prior_deg must be >= 0");
   IHS_CHECK_ARG(contact_noise_reference_mm >= 0, "fusion.contact_noise_reference_mm must be >= 0");
   IHS_CHECK_ARG(icp_retry_fraction >= 0 && icp_retry_fraction <= 1,
                 "fusion.icp_retry_fraction must be in [0, 1]");
@@ -90,39 +93,66 @@ int ObjectFusion::AddModelContacts(const FusionInput& input,
   return added;
 }
 
-int ObjectFusion::ApplyAnchors(std::vector<PointMatch>* contacts) const {
-  if (!options_.anchor_contacts) return 0;
+int ObjectFusion::ApplyAnchors(const Anchors& anchors, std::vector<PointMatch>* pairs) const {
   int anchored = 0;
-  for (PointMatch& contact : *contacts) {
-    const auto found = contact.id < 0 ? anchors_.end() : anchors_.find(contact.id);
-    if (found == anchors_.end()) continue;
-    contact.previous = cam_from_object_ * found->second.object_point;
+  for (PointMatch& pair : *pairs) {
+    const auto found = pair.id < 0 ? anchors.end() : anchors.find(pair.id);
+    if (found == anchors.end()) continue;
+    pair.previous = cam_from_object_ * found->second.object_point;
     ++anchored;
   }
   return anchored;
 }
 
-void ObjectFusion::UpdateAnchors(const std::vector<PointMatch>& contacts,
-                                 const Rigid3& cam_from_object) {
-  std::unordered_map<int, Anchor> held;
-  if (options_.anchor_contacts) {
-    const Rigid3 object_from_cam = cam_from_object.Inverse();
-    for (const PointMatch& contact : contacts) {
-      if (contact.id < 0) continue;
-      const Eigen::Vector3d seen = object_from_cam * contact.current;
-      Anchor anchor{seen, 1};
-      const auto found = anchors_.find(contact.id);
-      if (found != anchors_.end() &&
-          (found->second.object_point - seen).norm() <= options_.anchor_slip_mm) {
-        // The running mean of where the contact has been seen.
-        anchor = found->second;
-        ++anchor.observations;
-        anchor.object_point += (seen - anchor.object_point) / anchor.observations;
-      }
-      held[contact.id] = anchor;
+void ObjectFusion::UpdateAnchors(const std::vector<PointMatch>& pairs,
+                                 const Rigid3& cam_from_object, Anchors* anchors) const {
+  Anchors held;
+  const Rigid3 object_from_cam = cam_from_object.Inverse();
+  for (const PointMatch& pair : pairs) {
+    if (pair.id < 0) continue;
+    const Eigen::Vector3d seen = object_from_cam * pair.current;
+    Anchor anchor{seen, 1};
+    const auto found = anchors->find(pair.id);
+    if (found != anchors->end() &&
+        (found->second.object_point - seen).norm() <= options_.anchor_slip_mm) {
+      // The running mean of where the pair has been seen.
+      anchor = found->second;
+      ++anchor.observations;
+      anchor.object_point += (seen - anchor.object_point) / anchor.observations;
+    }
+    held[pair.id] = anchor;
+  }
+  *anchors = std::move(held);
+}
+
+void ObjectFusion::UpdateFeatureAnchors(const PairwiseInput& correspondences,
+                                        const Rigid3& cam_from_object) {
+  if (!options_.anchor_features) return;
+  for (const MatchSet& set : correspondences.sets) {
+    if (set.kind == MatchKind::kVisual) {
+      UpdateAnchors(set.pairs, cam_from_object, &feature_anchors_[set.source]);
     }
   }
-  anchors_ = std::move(held);
+}
+
+int ObjectFusion::DropPairsMovingWith(const Rigid3& hand_motion,
+                                      std::vector<PointMatch>* pairs) const {
+  const double inlier_mm = options_.pairwise.inlier_mm;
+  const auto moves_with_hand = [&](const PointMatch& pair) {
+    const double with_hand = (hand_motion * pair.previous - pair.current).norm();
+    return with_hand < inlier_mm && with_hand < (pair.previous - pair.current).norm();
+  };
+  const size_t before = pairs->size();
+  pairs->erase(std::remove_if(pairs->begin(), pairs->end(), moves_with_hand), pairs->end());
+  return static_cast<int>(before - pairs->size());
+}
+
+void ObjectFusion::MoveAnchors(const Rigid3& object_from_moved) {
+  for (auto& [id, anchor] : anchors_) anchor.object_point = object_from_moved * anchor.object_point;
+  for (auto& [source, anchors] : feature_anchors_) {
+    for (auto& [id, anchor] : anchors)
+      anchor.object_point = object_from_moved * anchor.object_point;
+  }
 }
 
 void ObjectFusion::CatchUpTurn(FusionResult* result) {
@@ -131,8 +161,7 @@ void ObjectFusion::CatchUpTurn(FusionResult* result) {
   const Rigid3 caught_up =
       turn_carry_.Turn(cam_from_object_, cam_from_object_ * pivot_in_object_, radians);
   // An anchor stays where the camera saw it; in the object frame it moves back by the turn.
-  const Rigid3 update = caught_up.Inverse() * cam_from_object_;
-  for (auto& [id, anchor] : anchors_) anchor.object_point = update * anchor.object_point;
+  MoveAnchors(caught_up.Inverse() * cam_from_object_);
   cam_from_object_ = caught_up;
   result->hand_caught_up_deg = radians * 180.0 / M_PI;
 }
@@ -188,7 +217,8 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   }
   UpdateContactNoise(contacts, step, &result);
   Integrate(input, object, pose, &result);
-  UpdateAnchors(contacts, pose);
+  if (options_.anchor_contacts) UpdateAnchors(contacts, pose, &anchors_);
+  UpdateFeatureAnchors(input.correspondences, pose);
   if (result.icp.ok) pivot_in_object_ = pose.Inverse() * result.icp.pivot;
   turn_carry_.Learn(result.ContactsUsed(), result.ContactsUsed() || result.pairwise.ok);
   CatchUpTurn(&result);
@@ -286,7 +316,7 @@ void ObjectFusion::ApplyCorrection(const KeyframeUpdate& update, FusionResult* r
   result->cam_from_object = cam_from_object_;
   result->loop_correction_mm = update.correction_mm;
   const Rigid3 object_from_moved = moved.Inverse();
-  for (auto& [id, anchor] : anchors_) anchor.object_point = object_from_moved * anchor.object_point;
+  MoveAnchors(object_from_moved);
   pivot_in_object_ = object_from_moved * pivot_in_object_;
   free_space_.Repose(
       [&](int stamp) { return KeyframeGraph::CorrectionAt(keyframes, update.corrections, stamp); });
@@ -309,17 +339,35 @@ Rigid3 ObjectFusion::Register(const FusionInput& input, bool with_contacts,
   // The contact sets as one, with the model's contacts and the anchors.
   PairwiseInput correspondences;
   for (const MatchSet& set : input.correspondences.sets) {
-    if (set.kind == MatchKind::kVisual) correspondences.sets.push_back(set);
+    if (set.kind == MatchKind::kVisual) {
+      correspondences.sets.push_back(set);
+      if (options_.drop_features_moving_back && result->hand_turn == HandTurn::kBack &&
+          input.hand_motion) {
+        result->features_moving_back +=
+            DropPairsMovingWith(*input.hand_motion, &correspondences.sets.back().pairs);
+      }
+      const auto anchors = feature_anchors_.find(set.source);
+      if (options_.anchor_features && anchors != feature_anchors_.end()) {
+        result->anchored_features +=
+            ApplyAnchors(anchors->second, &correspondences.sets.back().pairs);
+      }
+    }
     if (set.kind == MatchKind::kContact && with_contacts && with_tracker_contacts) {
       contacts->insert(contacts->end(), set.pairs.begin(), set.pairs.end());
     }
   }
   if (with_contacts) {
     result->model_contacts = AddModelContacts(input, contacts);
-    result->anchored_contacts = ApplyAnchors(contacts);
+    if (options_.anchor_contacts) result->anchored_contacts = ApplyAnchors(anchors_, contacts);
   }
   correspondences.sets.push_back({"contacts", MatchKind::kContact, *contacts});
-  result->pairwise = RegisterPair(correspondences, options_.pairwise);
+  PairwiseOptions pairwise = options_.pairwise;
+  if (turn_carry_.SurfaceLeavesTurnFree()) {
+    pairwise.min_visual_inliers =
+        std::max(pairwise.min_visual_inliers, options_.free_turn_min_visual_inliers);
+    pairwise.visual_turn_prior_deg = options_.free_turn_visual_prior_deg;
+  }
+  result->pairwise = RegisterPair(correspondences, pairwise);
   result->pairwise_ms = MillisecondsSince(pairwise_start);
   if (result->pairwise.ok) {
     pose = result->pairwise.current_from_previous * cam_from_object_;

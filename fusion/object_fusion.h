@@ -58,6 +58,21 @@ struct FusionOptions {
   /// cube turns it ends four of them within 0.6 mm where they ended 52-74 mm off, but three
   /// others slide mid-turn where they did not (docs/fusion.md, 2026-11-28).
   bool predict_moving = false;
+  /// Where the hand turns back (HandTurn::kBack: it swings back to re-grasp while the object
+  /// stays), visual pairs its motion explains better than standing still are left out: they
+  /// are on the hand (or on its edge with the object), and would turn the object back with it.
+  bool drop_features_moving_back = true;
+  /// Where the surface leaves a turn free (TurnCarry::SurfaceLeavesTurnFree: a ball, a bottle),
+  /// the features alone show that turn: a visual set needs at least
+  /// `free_turn_min_visual_inliers` inliers there (PairwiseOptions::min_visual_inliers where
+  /// larger), and its turn is shrunk with a prior of `free_turn_visual_prior_deg` instead of
+  /// PairwiseOptions::visual_turn_prior_deg. Measured on 41 generated turns (docs/fusion.md,
+  /// 2026-11-30): on untextured bottles the visual sets are 6-8 pairs on the edges and the
+  /// hand, in a few frames, and turn the object wrongly; on patterned ones 11-114 pairs in every
+  /// frame, of whose turn the prior of 1° kept 36-100 % a frame (what a frame loses is lost).
+  /// Where the surface fixes the turn (boxes) the pairwise options apply as they are.
+  int free_turn_min_visual_inliers = 10;
+  double free_turn_visual_prior_deg = 0.0;
   /// A frame needs this many object points.
   int min_object_points = 200;
   /// Fingertip contacts the tracker found only farther than this from the object's points
@@ -79,6 +94,13 @@ struct FusionOptions {
   /// `anchor_slip_mm` from its anchor after registration has slipped and starts anew.
   bool anchor_contacts = true;
   double anchor_slip_mm = 4.0;
+  /// Visual features matched from frame to frame (a source's pairs with ids: SIFT's keypoint
+  /// tracks) are anchored the same way: at the mean of where the track was seen in the object
+  /// frame, so that the features of a face seen over many frames hold it where they first saw
+  /// it rather than let it walk a little every frame (a flat face's slide along itself, which
+  /// its surface does not fix). A feature farther than `anchor_slip_mm` from its anchor starts
+  /// anew.
+  bool anchor_features = false;
   /// How much the contacts hold ICP follows how well they agree with the registered motion:
   /// `icp.anchor_share` is their share at `contact_noise_reference_mm` of disagreement (a
   /// running mean of each frame's median distance between the contacts and where the final pose
@@ -153,6 +175,11 @@ struct FusionResult {
   double coverage = 0;
   /// Contacts registered against their anchor rather than the previous frame.
   int anchored_contacts = 0;
+  /// Visual feature pairs registered against their anchor (FusionOptions::anchor_features).
+  int anchored_features = 0;
+  /// Visual pairs left out as moving with the hand turning back
+  /// (FusionOptions::drop_features_moving_back).
+  int features_moving_back = 0;
   /// Contact pairs found against the model that the tracker's contacts did not have (they are
   /// part of `pairwise.contacts` when used).
   int model_contacts = 0;
@@ -281,19 +308,29 @@ class ObjectFusion {
   // Adds the fingertip contacts found against the model that `contacts` lacks (by id); returns
   // how many pairs.
   int AddModelContacts(const FusionInput& input, std::vector<PointMatch>* contacts) const;
-  // Replaces the previous-frame positions of anchored contacts by their anchors (seen from the
-  // previous pose); returns how many.
-  int ApplyAnchors(std::vector<PointMatch>* contacts) const;
-  // After registering at `cam_from_object`: anchors of the contacts still held, updated.
-  void UpdateAnchors(const std::vector<PointMatch>& contacts, const Rigid3& cam_from_object);
-  // Where this frame recognised the one-way turn, turns the pose on by what the frames before
-  // missed (TurnCarry::TakeCatchUp), the anchors kept where the camera saw them.
-  void CatchUpTurn(FusionResult* result);
-
   struct Anchor {
     Eigen::Vector3d object_point;
     int observations = 0;
   };
+  // By the pairs' ids.
+  using Anchors = std::unordered_map<int, Anchor>;
+
+  // Replaces the previous-frame positions of anchored pairs by their anchors (seen from the
+  // previous pose); returns how many.
+  int ApplyAnchors(const Anchors& anchors, std::vector<PointMatch>* pairs) const;
+  // After registering at `cam_from_object`: the anchors of the pairs still held, updated.
+  void UpdateAnchors(const std::vector<PointMatch>& pairs, const Rigid3& cam_from_object,
+                     Anchors* anchors) const;
+  // The visual sets' anchors after registering at `cam_from_object`.
+  void UpdateFeatureAnchors(const PairwiseInput& correspondences, const Rigid3& cam_from_object);
+  // Leaves out of `pairs` those `hand_motion` explains better than standing still; returns how
+  // many (FusionOptions::drop_features_moving_back).
+  int DropPairsMovingWith(const Rigid3& hand_motion, std::vector<PointMatch>* pairs) const;
+  // Every anchor (contacts' and features') moved in the object frame by `object_from_moved`.
+  void MoveAnchors(const Rigid3& object_from_moved);
+  // Where this frame recognised the one-way turn, turns the pose on by what the frames before
+  // missed (TurnCarry::TakeCatchUp), the anchors kept where the camera saw them.
+  void CatchUpTurn(FusionResult* result);
 
   const CameraIntrinsics intrinsics_;
   const FusionOptions options_;
@@ -314,7 +351,9 @@ class ObjectFusion {
   // The running estimate of the contacts' disagreement with the registered motion, mm (starts
   // at the reference: the configured share until contacts have been seen).
   double contact_noise_mm_ = 0;
-  std::unordered_map<int, Anchor> anchors_;
+  Anchors anchors_;
+  // The visual features' anchors, by their source's name (FusionOptions::anchor_features).
+  std::unordered_map<std::string, Anchors> feature_anchors_;
   // The hand's vertices in the previous frame, when it was registered (else empty).
   std::vector<Eigen::Vector3f> previous_hand_;
   TurnCarry turn_carry_;

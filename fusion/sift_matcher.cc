@@ -1,6 +1,7 @@
 #include "fusion/sift_matcher.h"
 
 #include <algorithm>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -13,6 +14,8 @@ void SiftOptions::Check() const {
   IHS_CHECK_ARG(max_features >= 10 && max_features <= 100000,
                 "sift.max_features must be in [10, 100000]");
   IHS_CHECK_ARG(ratio > 0 && ratio < 1, "sift.ratio must be in (0, 1)");
+  IHS_CHECK_ARG(support_inside >= 0 && support_inside <= 4,
+                "sift.support_inside must be in [0, 4]");
 }
 
 struct SiftMatcher::State {
@@ -21,6 +24,14 @@ struct SiftMatcher::State {
   bool has_previous = false;
   std::vector<Eigen::Vector3d> previous_points;
   cv::Mat previous_descriptors;
+  // Each previous keypoint's track: the id its first sighting was given.
+  std::vector<int> previous_tracks;
+  int next_track = 0;
+  int NewTrack() {
+    const int track = next_track;
+    next_track = next_track == std::numeric_limits<int>::max() ? 0 : next_track + 1;
+    return track;
+  }
 };
 
 SiftMatcher::SiftMatcher(const CameraIntrinsics& intrinsics, SiftOptions options)
@@ -32,6 +43,32 @@ SiftMatcher::SiftMatcher(const CameraIntrinsics& intrinsics, SiftOptions options
 }
 
 SiftMatcher::~SiftMatcher() = default;
+
+namespace {
+
+// Drops the keypoints whose neighbourhood reaches farther off `mask` than `share` of its radius
+// allows (SiftOptions::support_inside).
+void KeepInside(const cv::Mat& mask, double share, std::vector<cv::KeyPoint>* keypoints,
+                cv::Mat* descriptors) {
+  // Each pixel's distance to the nearest pixel off the object (or the search box's edge).
+  cv::Mat padded, distance;
+  cv::copyMakeBorder(mask, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, 0);
+  cv::distanceTransform(padded, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  std::vector<cv::KeyPoint> kept;
+  cv::Mat kept_descriptors;
+  for (size_t k = 0; k < keypoints->size(); ++k) {
+    const cv::KeyPoint& keypoint = (*keypoints)[k];
+    const int u = cvRound(keypoint.pt.x) + 1, v = cvRound(keypoint.pt.y) + 1;
+    if (u < 0 || v < 0 || u >= distance.cols || v >= distance.rows) continue;
+    if (distance.at<float>(v, u) < share * keypoint.size / 2) continue;
+    kept.push_back(keypoint);
+    kept_descriptors.push_back(descriptors->row(static_cast<int>(k)));
+  }
+  *keypoints = std::move(kept);
+  *descriptors = kept_descriptors;
+}
+
+}  // namespace
 
 std::vector<PointMatch> SiftMatcher::Match(const Frame& frame,
                                            const std::vector<std::uint8_t>& object_mask) {
@@ -70,6 +107,8 @@ std::vector<PointMatch> SiftMatcher::Match(const Frame& frame,
       }
     }
     state_->sift->detectAndCompute(gray, mask, keypoints, descriptors);
+    if (options_.support_inside > 0)
+      KeepInside(mask, options_.support_inside, &keypoints, &descriptors);
     for (auto& keypoint : keypoints) keypoint.pt += cv::Point2f(box.x, box.y);
   }
   // Keypoints with depth at their (rounded) position, back-projected.
@@ -83,16 +122,27 @@ std::vector<PointMatch> SiftMatcher::Match(const Frame& frame,
     points.push_back(intrinsics_.BackProject(keypoints[k].pt.x, keypoints[k].pt.y, z));
     kept.push_back(descriptors.row(static_cast<int>(k)));
   }
+  std::vector<int> tracks(points.size(), -1);
   if (state_->has_previous && !kept.empty() && state_->previous_descriptors.rows >= 2) {
     std::vector<std::vector<cv::DMatch>> candidates;
     state_->matcher.knnMatch(kept, state_->previous_descriptors, candidates, 2);
+    std::vector<bool> continued(state_->previous_points.size(), false);
     for (const auto& pair : candidates) {
       if (pair.size() < 2 || pair[0].distance >= options_.ratio * pair[1].distance) continue;
-      matches.push_back({state_->previous_points[pair[0].trainIdx], points[pair[0].queryIdx]});
+      const int current = pair[0].queryIdx, previous = pair[0].trainIdx;
+      // A track goes on in one keypoint: another matched to the same one starts its own.
+      if (!continued[previous]) tracks[current] = state_->previous_tracks[previous];
+      continued[previous] = true;
+      if (tracks[current] < 0) tracks[current] = state_->NewTrack();
+      matches.push_back({state_->previous_points[previous], points[current], tracks[current]});
     }
+  }
+  for (int& track : tracks) {
+    if (track < 0) track = state_->NewTrack();
   }
   state_->previous_points = std::move(points);
   state_->previous_descriptors = kept;
+  state_->previous_tracks = std::move(tracks);
   state_->has_previous = true;
   return matches;
 }

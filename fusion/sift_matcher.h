@@ -21,6 +21,13 @@ struct SiftOptions {
   int max_features = 500;
   /// Lowe's ratio: a match counts when its distance is below this share of the second best's.
   double ratio = 0.8;
+  /// A keypoint counts only when the disc of this many times its radius (OpenCV's
+  /// KeyPoint::size / 2; its descriptor's window is about ten times that) lies on the object's
+  /// pixels: one on the object's edge describes the hand or the background beside it too, and
+  /// moves with the hand, or stands with the outline of a bottle spinning about its axis. 0: any
+  /// keypoint on the object's pixels. Off: on 37 generated full turns it moved single turns by
+  /// tens of degrees either way, no better on the whole (docs/fusion.md, 2026-11-30).
+  double support_inside = 0.0;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
@@ -38,8 +45,10 @@ class SiftMatcher final : public CorrespondenceSource {
   std::vector<PointMatch> Match(const MatchContext& context) override;
 
   /// The keypoints of `frame` inside `object_mask` (non-zero pixels, with depth), matched with
-  /// those of the previous call: (previous, current) 3D points, camera frame, mm. The first
-  /// call, and a frame without colour, give none.
+  /// those of the previous call: (previous, current) 3D points, camera frame, mm, each with
+  /// its keypoint's track as id (the same while the keypoint is matched from frame to frame,
+  /// so the fusion can hold it at one point of the object: FusionOptions::anchor_features).
+  /// The first call, and a frame without colour, give none.
   std::vector<PointMatch> Match(const Frame& frame, const std::vector<std::uint8_t>& object_mask);
 
  private:
