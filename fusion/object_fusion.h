@@ -69,7 +69,7 @@ struct FusionOptions {
   /// PairwiseOptions::visual_turn_prior_deg. Measured on 41 generated turns (docs/fusion.md,
   /// 2026-11-30): on untextured bottles the visual sets are 6-8 pairs on the edges and the
   /// hand, in a few frames, and turn the object wrongly; on patterned ones 11-114 pairs in every
-  /// frame, of whose turn the prior of 1° kept 36-100 % a frame (what a frame loses is lost).
+  /// frame, of whose turn the prior of 1° kept 10-100 % a frame (what a frame loses is lost).
   /// Where the surface fixes the turn (boxes) the pairwise options apply as they are.
   int free_turn_min_visual_inliers = 10;
   double free_turn_visual_prior_deg = 0.0;
