@@ -52,6 +52,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--textured", options.textured,
                "give a lathe object or the cube a colour pattern (default: one uniform colour)");
+  app.add_flag("--label", options.label,
+               "with --textured, a lathe object's pattern is a label of spots drawn from --seed "
+               "(every side different) instead of the checkerboard (which repeats every 60 deg)");
   app.add_flag("--empty-hand", options.empty_hand,
                "the hand makes the motion with nothing in it (the object is not rendered)");
   app.add_option("--motion", options.motion,
@@ -82,9 +85,10 @@ int main(int argc, char** argv) {
   app.add_option("--tilt-deg", options.scripted.tilt_deg,
                  "the object's axis leans this much toward the camera (scripted motion)")
       ->capture_default_str();
-  app.add_option("--start-azimuth-deg", options.scripted.start_azimuth_deg,
-                 "where the hand starts about the object's axis, from the default side "
-                 "position (scripted motion; the sphere at 90: the hand in front, its back to the camera)")
+  app.add_option(
+         "--start-azimuth-deg", options.scripted.start_azimuth_deg,
+         "where the hand starts about the object's axis, from the default side "
+         "position (scripted motion; the sphere at 90: the hand in front, its back to the camera)")
       ->capture_default_str();
   app.add_flag("--no-oni", no_oni, "do not write sequence.oni");
   app.add_flag("--no-tum", no_tum, "do not write the tum/ folder");

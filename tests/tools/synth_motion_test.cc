@@ -76,6 +76,55 @@ TEST(ObjectShapeTest, TheCubeAndThePlainBox) {
   for (const auto& c : plain.mesh().colors) ASSERT_EQ(c, blue);
 }
 
+// The colours a lathe mesh shows about its axis at height `z_mm`, turned by `turn_deg`: one per
+// 2° sector, from the vertex nearest that direction.
+std::vector<std::array<std::uint8_t, 3>> RingColours(const ObjectShape& shape, double z_mm,
+                                                     double turn_deg) {
+  std::vector<std::array<std::uint8_t, 3>> ring;
+  for (int sector = 0; sector < 180; ++sector) {
+    const double phi = (2.0 * sector + turn_deg) * M_PI / 180.0;
+    size_t best = 0;
+    double best_distance = 1e9;
+    for (size_t v = 0; v < shape.mesh().vertices.size(); ++v) {
+      const Eigen::Vector3f& p = shape.mesh().vertices[v];
+      const double r = std::hypot(p.x(), p.y());
+      const double d = std::abs(p.z() - z_mm) +
+                       r * std::abs(std::remainder(std::atan2(p.y(), p.x()) - phi, 2 * M_PI));
+      if (d < best_distance) best_distance = d, best = v;
+    }
+    ring.push_back(shape.mesh().colors[best]);
+  }
+  return ring;
+}
+
+// A label (textured with a seed) repeats nowhere about the axis; the checkerboard every 60°.
+TEST(ObjectShapeTest, ALabelRepeatsNowhereTheCheckerboardEverySixtyDegrees) {
+  const ObjectShape checker = ObjectShape::FromSpec("small-bottle", true);
+  const ObjectShape label = ObjectShape::FromSpec("small-bottle", true, {235, 235, 235}, 11u);
+  const ObjectShape other = ObjectShape::FromSpec("small-bottle", true, {235, 235, 235}, 12u);
+  int checker_60 = 0, differ_60 = 0, differ_other = 0;
+  for (double z : {20.0, 40.0, 60.0}) {
+    const auto ring = RingColours(label, z, 0), turned = RingColours(label, z, 60);
+    const auto other_ring = RingColours(other, z, 0);
+    const auto checker_ring = RingColours(checker, z, 0),
+               checker_turned = RingColours(checker, z, 60);
+    for (size_t i = 0; i < ring.size(); ++i) {
+      checker_60 += checker_ring[i] != checker_turned[i];
+      differ_60 += ring[i] != turned[i];
+      differ_other += ring[i] != other_ring[i];
+    }
+  }
+  // The checkerboard differs only where a sample falls on a sector's edge; spots cover part of
+  // the side: a fifth of the samples differ at least.
+  EXPECT_LT(checker_60, 3 * 180 / 20);
+  EXPECT_GT(differ_60, 3 * 180 / 5);
+  EXPECT_GT(differ_other, 3 * 180 / 5);
+  EXPECT_EQ(RingColours(label, 40, 0),
+            RingColours(ObjectShape::FromSpec("small-bottle", true, {235, 235, 235}, 11u), 40, 0))
+      << "the same seed, the same label";
+  EXPECT_THROW(ObjectShape::FromSpec("cube", true, {235, 235, 235}, 11u), std::invalid_argument);
+}
+
 // The signed distance the slow way: to every segment of the closed (r, z) outline but the axis,
 // inside by the crossings of a ray toward +r.
 double SignedDistanceOverEverySegment(const LatheProfile& profile, const Eigen::Vector3d& p) {
@@ -86,8 +135,8 @@ double SignedDistanceOverEverySegment(const LatheProfile& profile, const Eigen::
   double distance = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i + 1 < outline.size(); ++i) {
     const Eigen::Vector2d a = outline[i], ab = outline[i + 1] - a;
-    const double s = ab.squaredNorm() > 0 ? std::clamp((q - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
-                                          : 0.0;
+    const double s =
+        ab.squaredNorm() > 0 ? std::clamp((q - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
     distance = std::min(distance, (q - (a + s * ab)).norm());
   }
   bool inside = false;
@@ -106,8 +155,10 @@ TEST(ObjectShapeTest, TheSignedDistanceIsTheNearestOfEveryProfileSegment) {
   // The shape searches only the segments near the point's height: the same value, to the bit,
   // as over every segment; at random points and at the profile's own heights (flat steps, ties).
   std::vector<std::pair<std::string, LatheProfile>> profiles;
-  for (const std::string& name : PaperObjectNames()) profiles.emplace_back(name, PaperObjectProfile(name));
-  profiles.emplace_back("steps", LatheProfile{{0, 0}, {0, 20}, {10, 20}, {10, 5}, {10, 30}, {25, 30}, {25, 0}});
+  for (const std::string& name : PaperObjectNames())
+    profiles.emplace_back(name, PaperObjectProfile(name));
+  profiles.emplace_back(
+      "steps", LatheProfile{{0, 0}, {0, 20}, {10, 20}, {10, 5}, {10, 30}, {25, 30}, {25, 0}});
   std::mt19937 rng = test::Rng();
   for (const auto& [name, profile] : profiles) {
     const ObjectShape shape = ObjectShape::Lathe(name, profile, {200, 200, 200}, false);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <stdexcept>
 
 namespace ihs::synth {
@@ -22,17 +23,59 @@ double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
   return std::sqrt(dx * dx + dy * dy);
 }
 
+// A label on a lathe mesh: a disc for every 250 mm² of its side (48-400), 6-18 mm across on the
+// surface (arc length about the axis, height along it), at places drawn from `seed`, painted one
+// over the other in a dark and a mid shade of the colour and in its channels turned round. Unlike
+// the checkerboard it repeats nowhere: every side of the object looks different, as a printed label
+// does.
+void PaintLabel(std::uint32_t seed, TriangleMesh* mesh) {
+  struct Disc {
+    double phi, z, radius;
+    int shade;
+  };
+  float z0 = std::numeric_limits<float>::infinity(), z1 = -z0;
+  double radius_sum = 0;
+  for (const Eigen::Vector3f& p : mesh->vertices) {
+    z0 = std::min(z0, p.z()), z1 = std::max(z1, p.z());
+    radius_sum += std::hypot(p.x(), p.y());
+  }
+  const double side_mm2 =
+      2 * M_PI * radius_sum / std::max<size_t>(1, mesh->vertices.size()) * (z1 - z0);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> phi(-M_PI, M_PI), z(z0, z1), radius(3.0, 9.0);
+  std::vector<Disc> discs(std::clamp(static_cast<int>(side_mm2 / 250), 48, 400));
+  for (size_t i = 0; i < discs.size(); ++i) discs[i] = {phi(rng), z(rng), radius(rng), int(i % 3)};
+  for (size_t v = 0; v < mesh->vertices.size(); ++v) {
+    const Eigen::Vector3f& p = mesh->vertices[v];
+    const double r = std::hypot(p.x(), p.y()), at = std::atan2(p.y(), p.x());
+    const std::array<std::uint8_t, 3> base = mesh->colors[v];
+    for (const Disc& disc : discs) {
+      const double turn = std::remainder(at - disc.phi, 2 * M_PI);
+      if (std::hypot(r * turn, p.z() - disc.z) > disc.radius) continue;
+      std::array<std::uint8_t, 3>& color = mesh->colors[v];
+      for (int c = 0; c < 3; ++c) {
+        color[c] = disc.shade == 0   ? static_cast<std::uint8_t>(base[c] / 4)
+                   : disc.shade == 1 ? static_cast<std::uint8_t>(base[c] / 2)
+                                     : base[(c + 1) % 3];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ObjectShape ObjectShape::FromSpec(const std::string& spec, bool textured,
-                                  std::array<std::uint8_t, 3> rgb) {
+                                  std::array<std::uint8_t, 3> rgb,
+                                  std::optional<std::uint32_t> label_seed) {
+  if (label_seed && (spec == "box" || spec == "plain-box" || spec == "cube"))
+    throw std::invalid_argument("a label pattern is for lathe objects, not '" + spec + "'");
   if (spec == "box") return Box("box", Eigen::Vector3d(60, 45, 90));
   if (spec == "plain-box") return Box("plain-box", Eigen::Vector3d(60, 45, 90), false, rgb);
   if (spec == "cube") return Box("cube", Eigen::Vector3d(60, 60, 60), textured, rgb);
   if (spec.rfind("lathe:", 0) == 0) {
     const std::string file = spec.substr(6);
     if (file.empty()) throw std::invalid_argument("--object lathe:FILE needs a file name");
-    return Lathe(spec, ReadLatheProfile(file), rgb, textured);
+    return Lathe(spec, ReadLatheProfile(file), rgb, textured, label_seed);
   }
   const auto names = PaperObjectNames();
   if (std::find(names.begin(), names.end(), spec) == names.end()) {
@@ -40,11 +83,12 @@ ObjectShape ObjectShape::FromSpec(const std::string& spec, bool textured,
                                 "' (sphere, water-bottle, bowling-pin, small-bottle, box, "
                                 "plain-box, cube, lathe:FILE)");
   }
-  return Lathe(spec, PaperObjectProfile(spec), rgb, textured);
+  return Lathe(spec, PaperObjectProfile(spec), rgb, textured, label_seed);
 }
 
 ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& profile,
-                               std::array<std::uint8_t, 3> rgb, bool textured) {
+                               std::array<std::uint8_t, 3> rgb, bool textured,
+                               std::optional<std::uint32_t> label_seed) {
   ObjectShape shape;
   shape.name_ = name;
   shape.textured_ = textured;
@@ -54,7 +98,8 @@ ObjectShape ObjectShape::Lathe(const std::string& name, const LatheProfile& prof
     // A profile sampled every 2 mm, so the pattern's edges stay sharp, then a checkerboard.
     const LatheProfile dense = ResampleProfile(profile, 2.0);
     shape.mesh_ = MakeLatheMesh(dense, kLatheSegments, rgb);
-    for (size_t v = 0; v < shape.mesh_.vertices.size(); ++v) {
+    if (label_seed) PaintLabel(*label_seed, &shape.mesh_);
+    for (size_t v = 0; !label_seed && v < shape.mesh_.vertices.size(); ++v) {
       const Eigen::Vector3f& p = shape.mesh_.vertices[v];
       const double phi = std::atan2(p.y(), p.x()) + M_PI;
       const int sector = static_cast<int>(phi / (2 * M_PI) * 12) % 12;
@@ -121,7 +166,8 @@ double ObjectShape::SignedDistance(const Eigen::Vector3d& p) const {
   double distance = std::numeric_limits<double>::infinity();
   auto visit = [&](int i) {
     const double gap = std::max({0.0, q.x() - segment_r_[i][1], segment_r_[i][0] - q.x()});
-    if (gap < distance) distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
+    if (gap < distance)
+      distance = std::min(distance, SegmentDistance(q, outline_[i], outline_[i + 1]));
   };
   for (int i = at; i < segments && outline_z_[i] - q.y() < distance; ++i) visit(i);
   for (int i = at - 1; i >= 0 && q.y() - outline_z_[i + 1] < distance; --i) visit(i);

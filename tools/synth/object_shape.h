@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
+#include <optional>
 #include <string>
 
 #include "core/triangle_mesh.h"
@@ -20,14 +22,17 @@ class ObjectShape {
   /// 60 mm cube) or "lathe:FILE" (a profile file of "height radius" lines).
   /// Throws std::invalid_argument for an unknown name and ihs::InputError for a bad file.
   /// `textured`: lathe objects and the cube get a colour pattern (lathe objects in `rgb`; the
-  /// cube the box's); "box" always has its pattern, "plain-box" never.
+  /// cube the box's); "box" always has its pattern, "plain-box" never. `label_seed`: a lathe
+  /// object's pattern is a label drawn from that seed (LabelPattern) instead of the checkerboard.
   static ObjectShape FromSpec(const std::string& spec, bool textured = false,
-                              std::array<std::uint8_t, 3> rgb = {235, 235, 235});
+                              std::array<std::uint8_t, 3> rgb = {235, 235, 235},
+                              std::optional<std::uint32_t> label_seed = std::nullopt);
   /// A surface of revolution about +z, uniform colour `rgb`; textured: a checkerboard of 12
-  /// sectors around and 12 mm bands along the axis in `rgb` and a darker shade of it.
+  /// sectors around and 12 mm bands along the axis in `rgb` and a darker shade of it (it repeats
+  /// every 60° about the axis), or with `label_seed` a label (LabelPattern).
   static ObjectShape Lathe(const std::string& name, const LatheProfile& profile,
-                           std::array<std::uint8_t, 3> rgb = {235, 235, 235},
-                           bool textured = false);
+                           std::array<std::uint8_t, 3> rgb = {235, 235, 235}, bool textured = false,
+                           std::optional<std::uint32_t> label_seed = std::nullopt);
   /// A box of `size` (x, y, z) mm standing on z = 0, centred on the axis; textured: a
   /// checkerboard with a hue per face (MakeTexturedBox), else one uniform colour `rgb`.
   static ObjectShape Box(const std::string& name, const Eigen::Vector3d& size, bool textured = true,

@@ -291,6 +291,7 @@ json ManifestJson(const SequenceRenderer& renderer, const SequenceSummary& summa
         {"height_mm", object.height_mm()},
         {"max_radius_mm", object.max_radius_mm()},
         {"textured", object.textured()},
+        {"label", options.textured && options.label},
         {"volume_mm3", object.mesh().Volume()},
         {"rendered", !options.empty_hand}}},
       {"motion", options.motion},
@@ -334,6 +335,7 @@ void SequenceOptions::Check() const {
   IHS_CHECK_ARG(frame_step >= 1 && frame_step <= 10, "frame step must be in [1, 10]");
   IHS_CHECK_ARG(fps > 0 && fps <= 1000, "fps must be in (0, 1000]");
   IHS_CHECK_ARG(touch_mm > 0, "touch_mm must be positive");
+  IHS_CHECK_ARG(!label || textured, "a label (--label) needs a textured object (--textured)");
   IHS_CHECK_ARG(motion == "scripted" || motion.rfind("recorded:", 0) == 0,
                 "motion must be 'scripted' or 'recorded:DIR', got '" << motion << "'");
   IHS_CHECK_ARG(hand_scale >= 0.5 && hand_scale <= 2.0, "hand scale must be in [0.5, 2]");
@@ -349,8 +351,9 @@ void SequenceOptions::Check() const {
 
 SequenceRenderer::SequenceRenderer(const SequenceOptions& options)
     : options_(options),
-      object_(ObjectShape::FromSpec((options.Check(), options.object), options.textured,
-                                    options.object_rgb)) {
+      object_(ObjectShape::FromSpec(
+          (options.Check(), options.object), options.textured, options.object_rgb,
+          options.label ? std::optional<std::uint32_t>(options.seed) : std::nullopt)) {
   // The range's last frame, checked against the motion's length.
   auto checked_last = [&](int available) {
     const int last = options_.last_frame < 0 ? available - 1 : options_.last_frame;

@@ -39,6 +39,10 @@ struct SequenceOptions {
   std::string object = "sphere";
   /// Give a lathe object or the cube a colour pattern; by default it is one uniform colour.
   bool textured = false;
+  /// With `textured`, a lathe object's pattern is a label drawn from `seed`
+  /// (ObjectShape::FromSpec's label_seed): no side alike, where the checkerboard repeats every
+  /// 60° about the axis.
+  bool label = false;
   /// The hand makes the motion with nothing in it: the object is not rendered, no fingertip
   /// touches anything and nothing is held (the ground truth keeps the absent object's poses).
   /// A scanner must end such a recording as it ends one without a hand.
