@@ -122,6 +122,10 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (fused.icp_from_previous) entry["icp_from_previous"] = true;
     if (fused.keyframe) entry["keyframe"] = true, ++keyframes_;
     if (fused.loops > 0) entry["loops"] = fused.loops, loops_ += fused.loops;
+    if (fused.feature_loops > 0) {
+      entry["feature_loops"] = fused.feature_loops;
+      feature_loops_ += fused.feature_loops;
+    }
     if (fused.loop_correction_mm > 0) {
       entry["loop_correction_mm"] = fused.loop_correction_mm;
       entry["refuse_ms"] = fused.refuse_ms;
@@ -176,6 +180,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"icp_slid_frames", icp_slid_frames_},
                             {"keyframes", keyframes_},
                             {"loops", loops_},
+                            {"feature_loops", feature_loops_},
                             {"loop_corrections", loop_corrections_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},

@@ -77,6 +77,7 @@ class ScanRecord {
   // Keyframes kept, loops closed and drift corrections made (keyframe_graph.h).
   std::int64_t keyframes_ = 0;
   std::int64_t loops_ = 0;
+  std::int64_t feature_loops_ = 0;
   std::int64_t loop_corrections_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;

@@ -243,6 +243,23 @@ void AddLoopClosureOptions(OptionRegistry& r, fusion::LoopClosureOptions* option
   r.Add("fusion.loop_closure.lever_mm", &l.graph.lever_mm,
         "the pose graph weighs turns by how far they move points this far from the object's "
         "origin, mm");
+  r.Add("fusion.loop_closure.feature_loops", &l.feature_loops,
+        "where the surface leaves the turn free, loops are registered by the keyframes' SIFT "
+        "keypoints (objects with a pattern)");
+  r.Add("fusion.loop_closure.feature_keypoints", &l.feature_keypoints,
+        "SIFT keypoints a keyframe keeps for that, at most");
+  r.Add("fusion.loop_closure.feature_max_turn_deg", &l.feature_max_turn_deg,
+        "earlier keyframes within this turn of a new one are tried, degrees");
+  r.Add("fusion.loop_closure.feature_tries", &l.feature_tries,
+        "of those, the ones with most matches tried per new keyframe");
+  r.Add("fusion.loop_closure.feature_min_inliers", &l.feature_min_inliers,
+        "matches one motion must explain to make a loop");
+  r.Add("fusion.loop_closure.feature_inlier_mm", &l.feature_inlier_mm,
+        "a match explained by a motion lands within this distance, mm");
+  r.Add("fusion.loop_closure.feature_distinct_deg", &l.feature_distinct_deg,
+        "motions turned more than this from the loop's are its rivals, degrees");
+  r.Add("fusion.loop_closure.feature_max_rival", &l.feature_max_rival,
+        "no loop where a rival explains more than this share of the loop's matches");
 }
 
 }  // namespace

@@ -3,15 +3,43 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
 #include <utility>
 
 #include "core/check.h"
+#include "core/rigid_fit.h"
+#include "fusion/pairwise_registration.h"
 
 namespace ihs::fusion {
 namespace {
 
 // The angle between two poses' views of the object, degrees.
 double TurnDeg(const Rigid3& a, const Rigid3& b) { return a.RotationAngleToRad(b) * 180.0 / M_PI; }
+
+// A keyframe's descriptors as OpenCV's matcher takes them (one float row each).
+cv::Mat Descriptors(const Keyframe& keyframe) {
+  const int rows = static_cast<int>(keyframe.keypoints.size());
+  cv::Mat bytes(rows, ObjectKeypoints::kDescriptorSize, CV_8U,
+                const_cast<std::uint8_t*>(keyframe.descriptors.data()));
+  cv::Mat floats;
+  bytes.convertTo(floats, CV_32F);
+  return floats;
+}
+
+// The pairs (from's keypoint, to's keypoint) whose descriptors match by Lowe's ratio.
+std::vector<PointMatch> MatchKeypoints(const Keyframe& from, const Keyframe& to, double ratio) {
+  std::vector<PointMatch> pairs;
+  if (from.keypoints.empty() || to.keypoints.size() < 2) return pairs;
+  std::vector<std::vector<cv::DMatch>> candidates;
+  cv::BFMatcher(cv::NORM_L2).knnMatch(Descriptors(from), Descriptors(to), candidates, 2);
+  for (const auto& pair : candidates) {
+    if (pair.size() < 2 || pair[0].distance >= ratio * pair[1].distance) continue;
+    pairs.push_back({from.keypoints[pair[0].queryIdx].cast<double>(),
+                     to.keypoints[pair[0].trainIdx].cast<double>()});
+  }
+  return pairs;
+}
 
 Eigen::Vector3d Centroid(const std::vector<Eigen::Vector3f>& points) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -39,6 +67,16 @@ void LoopClosureOptions::Check() const {
   IHS_CHECK_ARG(max_rms_mm > 0 && max_correction_mm > 0 && refuse_min_mm >= 0,
                 "fusion.loop_closure.max_rms_mm and max_correction_mm must be positive, "
                 "refuse_min_mm >= 0");
+  IHS_CHECK_ARG(feature_keypoints >= 10 && feature_keypoints <= 2000,
+                "fusion.loop_closure.feature_keypoints must be in [10, 2000]");
+  IHS_CHECK_ARG(feature_max_turn_deg > 0 && feature_max_turn_deg <= 180,
+                "fusion.loop_closure.feature_max_turn_deg must be in (0, 180]");
+  IHS_CHECK_ARG(feature_tries >= 1, "fusion.loop_closure.feature_tries must be >= 1");
+  IHS_CHECK_ARG(feature_min_inliers >= 3, "fusion.loop_closure.feature_min_inliers must be >= 3");
+  IHS_CHECK_ARG(feature_inlier_mm > 0 && feature_distinct_deg > 0,
+                "fusion.loop_closure.feature_inlier_mm and feature_distinct_deg must be positive");
+  IHS_CHECK_ARG(feature_max_rival >= 0 && feature_max_rival <= 1,
+                "fusion.loop_closure.feature_max_rival must be in [0, 1]");
   graph.Check();
 }
 
@@ -91,7 +129,7 @@ Rigid3 KeyframeGraph::CorrectionAt(const std::vector<Keyframe>& keyframes,
 
 KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std::uint8_t>& mask,
                                       const std::array<int, 4>& box, const Rigid3& cam_from_object,
-                                      int stamp, double kept_pairs) {
+                                      int stamp, double kept_pairs, bool turn_free) {
   KeyframeUpdate update;
   chain_kept_ = std::min(chain_kept_, kept_pairs);
   if (!options_.enabled || static_cast<int>(keyframes_.size()) >= options_.max_keyframes ||
@@ -102,11 +140,21 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
       TurnDeg(cam_from_object, keyframes_.back().cam_from_object) < options_.keyframe_turn_deg) {
     return update;
   }
+  const bool by_keypoints = turn_free && options_.feature_loops;
   keyframes_.push_back(Keep(frame, mask, box, cam_from_object, stamp));
+  if (by_keypoints) {
+    SiftOptions sift;
+    sift.max_features = options_.feature_keypoints;
+    const ObjectKeypoints found = DetectObjectKeypoints(frame, mask, intrinsics_, sift);
+    keyframes_.back().keypoints = found.points;
+    // SIFT's descriptors are whole numbers in [0, 255] (OpenCV saturates them to bytes).
+    keyframes_.back().descriptors.assign(found.descriptors.begin(), found.descriptors.end());
+  }
   update.added = true;
   if (keyframes_.size() == 1) return update;
   AddChainEdge();
-  update.loops = AddConfirmedLoops();
+  update.loops = AddConfirmedLoops(by_keypoints);
+  update.feature_loops = feature_loops_;
   if (update.loops > 0) Solve(&update);
   return update;
 }
@@ -124,17 +172,22 @@ void KeyframeGraph::AddChainEdge() {
        std::pow(trust, 4)});
 }
 
-int KeyframeGraph::AddConfirmedLoops() {
+int KeyframeGraph::AddConfirmedLoops(bool by_keypoints) {
   // Loops with the earlier keyframes. One counts only where another agrees with it — of this
   // keyframe or of one of the last `loop_pending_keyframes`, carried along the chain — on
   // where this keyframe's object is, within `loop_agreement_mm`: a view that registers where
   // it is not (a cube's faces are alike) rarely does so twice alike.
   const int newest = static_cast<int>(keyframes_.size()) - 1;
   std::vector<Loop> found;
-  for (int earlier : LoopCandidates()) {
-    if (std::optional<Rigid3> motion = Register(keyframes_[newest], keyframes_[earlier])) {
+  for (int earlier : by_keypoints ? KeypointCandidates() : LoopCandidates()) {
+    const std::optional<Rigid3> motion =
+        by_keypoints ? RegisterByKeypoints(keyframes_[newest], keyframes_[earlier])
+                     : Register(keyframes_[newest], keyframes_[earlier]);
+    if (motion) {
       found.push_back({{newest, earlier, *motion, 1.0},
-                       motion->Inverse() * keyframes_[earlier].cam_from_object});
+                       motion->Inverse() * keyframes_[earlier].cam_from_object,
+                       false,
+                       by_keypoints});
     }
   }
   std::vector<Loop*> all;
@@ -156,11 +209,13 @@ int KeyframeGraph::AddConfirmedLoops() {
     }
   }
   int added = 0;
+  feature_loops_ = 0;
   std::vector<Loop> still_pending;
   for (const Loop* loop : all) {
     if (loop->confirmed) {
       edges_.push_back(loop->edge);
       ++added;
+      feature_loops_ += loop->by_keypoints ? 1 : 0;
     } else if (newest - loop->edge.from < options_.loop_pending_keyframes) {
       still_pending.push_back(*loop);
     }
@@ -213,6 +268,56 @@ std::vector<int> KeyframeGraph::LoopCandidates() const {
   for (size_t i = 0; i < near.size() && static_cast<int>(i) < options_.loop_tries; ++i)
     candidates.push_back(near[i].second);
   return candidates;
+}
+
+std::vector<int> KeyframeGraph::KeypointCandidates() const {
+  const int newest = static_cast<int>(keyframes_.size()) - 1;
+  const Keyframe& now = keyframes_[newest];
+  std::vector<std::pair<int, int>> matched;  // (-matches, keyframe)
+  if (static_cast<int>(now.keypoints.size()) < options_.feature_min_inliers) return {};
+  for (int earlier = 0; earlier + options_.loop_min_gap <= newest; ++earlier) {
+    const Keyframe& then = keyframes_[earlier];
+    if (static_cast<int>(then.keypoints.size()) < options_.feature_min_inliers ||
+        TurnDeg(now.cam_from_object, then.cam_from_object) > options_.feature_max_turn_deg) {
+      continue;
+    }
+    SiftOptions sift;
+    const int matches = static_cast<int>(MatchKeypoints(now, then, sift.ratio).size());
+    if (matches >= options_.feature_min_inliers) matched.emplace_back(-matches, earlier);
+  }
+  std::sort(matched.begin(), matched.end());
+  std::vector<int> candidates;
+  for (size_t i = 0; i < matched.size() && static_cast<int>(i) < options_.feature_tries; ++i)
+    candidates.push_back(matched[i].second);
+  return candidates;
+}
+
+std::optional<Rigid3> KeyframeGraph::RegisterByKeypoints(const Keyframe& from, const Keyframe& to) {
+  const std::vector<PointMatch> pairs = MatchKeypoints(from, to, SiftOptions{}.ratio);
+  PairwiseOptions ransac;
+  ransac.min_visual_inliers = options_.feature_min_inliers;
+  ransac.inlier_mm = options_.feature_inlier_mm;
+  ransac.ransac_iterations = 500;
+  int rival = 0;
+  const std::vector<PointMatch> inliers =
+      ConsistentPairs(pairs, ransac, options_.feature_distinct_deg, &rival);
+  if (inliers.empty() || rival > options_.feature_max_rival * inliers.size()) return std::nullopt;
+  std::vector<Eigen::Vector3d> a, b;
+  for (const PointMatch& pair : inliers) a.push_back(pair.previous), b.push_back(pair.current);
+  DrawTarget(to);
+  int icp_inliers = 0;
+  const std::optional<Rigid3> motion =
+      Align(from, FitRigidTransform(a, b), &icp_inliers, /*free_allowed=*/true);
+  if (!motion || !Plausible(*motion, from, to)) return std::nullopt;
+  return motion;
+}
+
+bool KeyframeGraph::Plausible(const Rigid3& motion, const Keyframe& from,
+                              const Keyframe& to) const {
+  // Where the registration puts `from`'s object, against where the chain put it.
+  const Rigid3 registered = motion.Inverse() * to.cam_from_object;
+  return PoseDistanceMm(registered, from.cam_from_object, options_.graph.lever_mm) <=
+         options_.max_correction_mm;
 }
 
 void KeyframeGraph::DrawTarget(const Keyframe& keyframe) {
@@ -280,18 +385,12 @@ std::optional<Rigid3> KeyframeGraph::Register(const Keyframe& from, const Keyfra
     std::optional<Rigid3> motion = Align(from, start, &inliers);
     if (motion && inliers > best_inliers) best = motion, best_inliers = inliers;
   }
-  if (!best) return std::nullopt;
-  // Where the registration puts `from`'s object, against where the chain put it.
-  const Rigid3 registered = best->Inverse() * to.cam_from_object;
-  if (PoseDistanceMm(registered, from.cam_from_object, options_.graph.lever_mm) >
-      options_.max_correction_mm) {
-    return std::nullopt;
-  }
+  if (!best || !Plausible(*best, from, to)) return std::nullopt;
   return best;
 }
 
-std::optional<Rigid3> KeyframeGraph::Align(const Keyframe& from, const Rigid3& start,
-                                           int* inliers) const {
+std::optional<Rigid3> KeyframeGraph::Align(const Keyframe& from, const Rigid3& start, int* inliers,
+                                           bool free_allowed) const {
   Rigid3 motion = start;
   IcpOptions options = icp_;
   IcpResult result;
@@ -303,7 +402,7 @@ std::optional<Rigid3> KeyframeGraph::Align(const Keyframe& from, const Rigid3& s
     if (!result.ok) return std::nullopt;
     motion = result.cam_from_volume.Inverse() * motion;
   }
-  if (result.free_directions > 0 ||
+  if ((result.free_directions > 0 && !free_allowed) ||
       result.inliers < options_.min_inlier_fraction * from.points.size() ||
       result.rms_mm > options_.max_rms_mm) {
     return std::nullopt;

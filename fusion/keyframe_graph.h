@@ -8,9 +8,11 @@
 // corrected poses and carries on from the corrected pose (as Weise et al. 2011 close loops in
 // their in-hand scanner, with the keyframes re-fused instead of a deformed surfel model).
 //
-// A loop is taken only from a registration that fixes every direction: a ball or a bottle
-// turned about its axis looks the same from every side of the turn, so there its loop says
-// nothing about the turn and none is taken.
+// A loop is taken from a registration of the shapes only where it fixes every direction: a ball
+// or a bottle turned about its axis looks the same from every side of the turn, so there its
+// loop says nothing about the turn. There the keyframes' SIFT keypoints are registered instead
+// where the object has colour (a label): the turn the hand carried drifts by tens of degrees
+// over a whole turn, and its pattern shows where the object really is.
 
 #include <Eigen/Core>
 #include <array>
@@ -23,6 +25,7 @@
 #include "core/rigid3.h"
 #include "fusion/icp.h"
 #include "fusion/pose_graph.h"
+#include "fusion/sift_matcher.h"
 #include "fusion/tsdf_volume.h"
 
 namespace ihs::fusion {
@@ -69,6 +72,24 @@ struct LoopClosureOptions {
   /// frames): a loop's correction then goes where the chain broke rather than spread over
   /// the turn, and evenly where nothing broke (a slow drift).
   double chain_trusted_kept = 0.95;
+  /// Where the surface leaves the object's turn free (Observe's `turn_free`), keyframes with
+  /// colour keep up to `feature_keypoints` SIFT keypoints, and a new one is registered by them
+  /// to each earlier one at least loop_min_gap back within `feature_max_turn_deg` (the drift of
+  /// the turn the hand carried reaches tens of degrees) that shares `feature_min_inliers`
+  /// matches (Lowe's ratio), at most `feature_tries` of them, most matches first: RANSAC over
+  /// the matched points, inliers within `feature_inlier_mm`. It is a loop where that many agree
+  /// and no motion turned more than `feature_distinct_deg` from it has more than
+  /// `feature_max_rival` of their number (a pattern that repeats round the object, as a
+  /// checkerboard does every 60°, lets two motions explain the matches). Such loops are
+  /// confirmed by a second one as every loop is.
+  bool feature_loops = false;
+  int feature_keypoints = 150;
+  double feature_max_turn_deg = 90.0;
+  int feature_tries = 4;
+  int feature_min_inliers = 12;
+  double feature_inlier_mm = 4.0;
+  double feature_distinct_deg = 25.0;
+  double feature_max_rival = 0.5;
   PoseGraphOptions graph;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -87,6 +108,10 @@ struct Keyframe {
   std::vector<std::uint8_t> rgb;
   /// Every other pixel's point in each direction (camera frame, mm): what a loop registers.
   std::vector<Eigen::Vector3f> points;
+  /// Its SIFT keypoints' points (camera frame, mm) and descriptors (128 bytes each), kept where
+  /// the surface left the turn free (LoopClosureOptions::feature_loops).
+  std::vector<Eigen::Vector3f> keypoints;
+  std::vector<std::uint8_t> descriptors;
 
   /// Writes its depth, colour and mask into full-size `frame` and `mask` (which must be
   /// zero there), and ClearFrom takes them out again.
@@ -99,6 +124,8 @@ struct Keyframe {
 struct KeyframeUpdate {
   bool added = false;
   int loops = 0;
+  /// Of those, registered by the keyframes' keypoints.
+  int feature_loops = 0;
   bool corrected = false;
   /// The largest move of a keyframe (mm at the lever).
   double correction_mm = 0;
@@ -113,10 +140,11 @@ class KeyframeGraph {
 
   /// Considers a fused frame: the object's pixels under `mask` inside `box` (u0, v0, u1, v1),
   /// fused at `cam_from_object`, the `stamp`-th fused frame, whose ICP kept `kept_pairs` of the
-  /// pairs it started with (1 where it did not run).
+  /// pairs it started with (1 where it did not run); `turn_free`: the surface leaves the
+  /// object's turn free (its loops are then registered by keypoints).
   KeyframeUpdate Observe(const Frame& frame, const std::vector<std::uint8_t>& mask,
                          const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp,
-                         double kept_pairs = 1.0);
+                         double kept_pairs = 1.0, bool turn_free = false);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
   /// How the object frame of a frame with `stamp` moved in the last correction: the
@@ -128,21 +156,33 @@ class KeyframeGraph {
   /// points on the second's surface, starting from their poses; none where that is not a
   /// loop (see LoopClosureOptions).
   std::optional<Rigid3> Register(const Keyframe& from, const Keyframe& to);
+  /// The same motion from the two keyframes' keypoints (see LoopClosureOptions::feature_loops);
+  /// none where they do not make it a loop.
+  /// Their matches place `from` (RANSAC), ICP of the views from there fixes what the shapes
+  /// fix and leaves the turn they leave free where the keypoints put it.
+  std::optional<Rigid3> RegisterByKeypoints(const Keyframe& from, const Keyframe& to);
 
  private:
   // The keyframe of a fused frame.
   Keyframe Keep(const Frame& frame, const std::vector<std::uint8_t>& mask,
                 const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp) const;
   // ICP of `from`'s points on scratch_ (the target drawn) from `start`, coarse to fine: the
-  // motion where it is a loop (and its pairs in `inliers`).
-  std::optional<Rigid3> Align(const Keyframe& from, const Rigid3& start, int* inliers) const;
+  // motion where it is a loop (and its pairs in `inliers`); with `free_allowed`, also where
+  // the surfaces leave directions free (they stay where `start` put them).
+  std::optional<Rigid3> Align(const Keyframe& from, const Rigid3& start, int* inliers,
+                              bool free_allowed = false) const;
   // The newest keyframe's edge to the one before: the tracked motion, weighed by chain_kept_.
   void AddChainEdge();
-  // Registers the newest keyframe against earlier ones, adds the loops that a second one
-  // confirms (its own or pending ones) to the graph and returns how many.
-  int AddConfirmedLoops();
+  // Registers the newest keyframe against earlier ones (by keypoints: `by_keypoints`), adds the
+  // loops that a second one confirms (its own or pending ones) to the graph and returns how
+  // many.
+  int AddConfirmedLoops(bool by_keypoints);
   // The earlier keyframes the newest one is tried against, nearest turn first.
   std::vector<int> LoopCandidates() const;
+  // Those it is tried against by keypoints, most matches first.
+  std::vector<int> KeypointCandidates() const;
+  // Whether a loop's motion from `from` to `to` moves `from` by at most max_correction_mm.
+  bool Plausible(const Rigid3& motion, const Keyframe& from, const Keyframe& to) const;
   // `keyframe`'s surface as ICP's model image (scratch_), normals from its depth.
   void DrawTarget(const Keyframe& keyframe);
   // Solves the graph; where it moves a keyframe by more than refuse_min_mm, takes the new
@@ -160,10 +200,13 @@ class KeyframeGraph {
     PoseGraphEdge edge;
     Rigid3 placed;
     bool confirmed = false;
+    bool by_keypoints = false;
   };
   std::vector<Loop> pending_;
   // The least share of its first pairs a frame's ICP kept since the last keyframe.
   double chain_kept_ = 1.0;
+  // Loops registered by keypoints among those the last AddConfirmedLoops confirmed.
+  int feature_loops_ = 0;
   RaycastImage scratch_;
 };
 

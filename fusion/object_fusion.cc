@@ -300,10 +300,12 @@ void ObjectFusion::CloseLoops(const ObjectPixels& object, FusionResult* result) 
       result->icp.first_inliers > 0
           ? static_cast<double>(result->icp.inliers) / result->icp.first_inliers
           : 1.0;
-  const KeyframeUpdate update = keyframes_.Observe(object.frame, object.mask, object.box,
-                                                   cam_from_object_, fused_frames_, kept_pairs);
+  const KeyframeUpdate update =
+      keyframes_.Observe(object.frame, object.mask, object.box, cam_from_object_, fused_frames_,
+                         kept_pairs, turn_carry_.SurfaceLeavesTurnFree());
   result->keyframe = update.added;
   result->loops = update.loops;
+  result->feature_loops = update.feature_loops;
   if (update.corrected) ApplyCorrection(update, result);
 }
 

@@ -205,6 +205,8 @@ struct FusionResult {
   /// was re-fused from the keyframes and `cam_from_object` is the corrected pose).
   bool keyframe = false;
   int loops = 0;
+  /// Of those, registered by the keyframes' keypoints (LoopClosureOptions::feature_loops).
+  int feature_loops = 0;
   double loop_correction_mm = 0;
   double refuse_ms = 0;
   /// Whether ICP started from the previous pose won over the registration's (see

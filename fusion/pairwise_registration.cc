@@ -41,18 +41,18 @@ std::vector<PointMatch> PairwiseInput::All(MatchKind kind) const {
   return all;
 }
 
-namespace {
-
-// The largest set of visual pairs consistent with one rigid motion (hypotheses from three
-// pairs), or none when it has fewer than `min_inliers`.
-std::vector<PointMatch> RansacInliers(const std::vector<PointMatch>& matches,
-                                      const PairwiseOptions& options) {
+std::vector<PointMatch> ConsistentPairs(const std::vector<PointMatch>& matches,
+                                        const PairwiseOptions& options, double distinct_deg,
+                                        int* rival) {
   const int n = static_cast<int>(matches.size());
+  if (rival) *rival = 0;
   if (n < options.min_visual_inliers) return {};
   std::mt19937 rng(options.seed);
   std::uniform_int_distribution<int> pick(0, n - 1);
   const double inlier_sq = options.inlier_mm * options.inlier_mm;
   std::vector<int> best;
+  // Every hypothesis's motion and inlier count, for the rival (only when asked for).
+  std::vector<std::pair<Rigid3, int>> tried;
   for (int iteration = 0; iteration < options.ransac_iterations; ++iteration) {
     const int a = pick(rng), b = pick(rng), c = pick(rng);
     const Eigen::Vector3d& pa = matches[a].previous;
@@ -74,6 +74,7 @@ std::vector<PointMatch> RansacInliers(const std::vector<PointMatch>& matches,
       if ((motion * matches[i].previous - matches[i].current).squaredNorm() < inlier_sq)
         inliers.push_back(i);
     }
+    if (rival) tried.emplace_back(motion, static_cast<int>(inliers.size()));
     if (inliers.size() > best.size()) best = std::move(inliers);
   }
   if (static_cast<int>(best.size()) < options.min_visual_inliers) return {};
@@ -85,9 +86,17 @@ std::vector<PointMatch> RansacInliers(const std::vector<PointMatch>& matches,
   for (const PointMatch& m : matches) {
     if ((motion * m.previous - m.current).squaredNorm() < inlier_sq) inliers.push_back(m);
   }
+  if (rival) {
+    for (const auto& [other, count] : tried) {
+      if (other.RotationAngleToRad(motion) * 180.0 / M_PI > distinct_deg)
+        *rival = std::max(*rival, count);
+    }
+  }
   return static_cast<int>(inliers.size()) >= options.min_visual_inliers ? inliers
                                                                         : std::vector<PointMatch>{};
 }
+
+namespace {
 
 // The largest standard deviation of the contacts' previous positions, mm.
 double Spread(const std::vector<PointMatch>& contacts) {
@@ -160,9 +169,9 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
   options.Check();
   PairwiseResult result;
   std::vector<PointMatch> visual;
-  if (options.visual_weight > 0) visual = RansacInliers(input.All(MatchKind::kVisual), options);
+  if (options.visual_weight > 0) visual = ConsistentPairs(input.All(MatchKind::kVisual), options);
   const std::vector<PointMatch> input_contacts = input.All(MatchKind::kContact);
-  // RansacInliers returns a set of at least min_visual_inliers (>= 3) pairs, or none.
+  // ConsistentPairs returns a set of at least min_visual_inliers (>= 3) pairs, or none.
   VisualFit visual_fit;
   if (!visual.empty()) {
     visual_fit = FitVisual(visual);

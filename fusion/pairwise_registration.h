@@ -104,6 +104,15 @@ struct PairwiseResult {
   double rms_mm = 0;
 };
 
+/// The largest set of `matches` consistent with one rigid motion (RANSAC: hypotheses from three
+/// pairs, `options`' iterations, inlier distance and seed), or none where it has fewer than
+/// options.min_visual_inliers. With `rival`: the most inliers of a hypothesis turned by more
+/// than `distinct_deg` from the motion kept (a pattern that repeats round an object lets two
+/// motions explain its pairs).
+std::vector<PointMatch> ConsistentPairs(const std::vector<PointMatch>& matches,
+                                        const PairwiseOptions& options, double distinct_deg = 0,
+                                        int* rival = nullptr);
+
 /// Solves one frame pair.
 PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& options = {});
 

@@ -4,6 +4,7 @@
 // match back-projected to 3D with its depth. Hand pixels never count: only the object mask is
 // searched.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -32,6 +33,23 @@ struct SiftOptions {
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;
 };
+
+/// SIFT keypoints of a frame's object pixels: where each is (camera frame, mm, from its depth)
+/// and its descriptor.
+struct ObjectKeypoints {
+  std::vector<Eigen::Vector3f> points;
+  /// 128 floats a keypoint, keypoint after keypoint.
+  std::vector<float> descriptors;
+  static constexpr int kDescriptorSize = 128;
+  size_t size() const { return points.size(); }
+};
+
+/// The keypoints of `frame` inside `object_mask` (non-zero pixels, with depth), strongest first
+/// (SiftMatcher's detector); none without colour.
+ObjectKeypoints DetectObjectKeypoints(const Frame& frame,
+                                      const std::vector<std::uint8_t>& object_mask,
+                                      const CameraIntrinsics& intrinsics,
+                                      const SiftOptions& options = {});
 
 /// Matches each frame's object keypoints with the previous frame's. Not thread-safe.
 class SiftMatcher final : public CorrespondenceSource {

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <vector>
 
 #include "fusion/pose_graph.h"
@@ -68,17 +69,50 @@ struct TurnResult {
   double drifted_end_mm = 0;
 };
 
-// A full turn and a bit of an object rendered exactly, tracked with drift, through a graph.
-TurnResult TurnWithDrift(const Eigen::Vector3d& semi_axes_mm) {
+// Paints `frame` (the object at `cam_from_object`) with 80 spots of three colours at places on
+// the object drawn from a fixed seed, on a grey ground: a pattern that repeats nowhere.
+void PaintSpots(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, Frame* frame) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> size(0.1, 0.25);
+  std::vector<std::pair<Eigen::Vector3d, double>> spots;
+  for (int i = 0; i < 80; ++i) {
+    spots.emplace_back(Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized(),
+                       size(rng));
+  }
+  const std::array<std::array<std::uint8_t, 3>, 3> colours = {
+      {{30, 30, 160}, {200, 40, 40}, {20, 150, 60}}};
+  const Rigid3 object_from_cam = cam_from_object.Inverse();
+  for (int v = 0; v < frame->height; ++v) {
+    for (int u = 0; u < frame->width; ++u) {
+      const std::uint16_t depth = frame->DepthAt(u, v);
+      if (depth == 0) continue;
+      const Eigen::Vector3d at =
+          (object_from_cam * intrinsics.BackProject(u, v, depth)).normalized();
+      std::array<std::uint8_t, 3> colour = {200, 200, 200};
+      for (size_t k = 0; k < spots.size(); ++k) {
+        if (std::acos(std::clamp(at.dot(spots[k].first), -1.0, 1.0)) < spots[k].second)
+          colour = colours[k % 3];
+      }
+      std::copy(colour.begin(), colour.end(), &frame->rgb[3 * (v * frame->width + u)]);
+    }
+  }
+}
+
+// A full turn and a bit of an object rendered exactly, tracked with drift, through a graph;
+// `spotted`: painted with spots, and judged a surface that leaves the turn free.
+TurnResult TurnWithDrift(const Eigen::Vector3d& semi_axes_mm,
+                         const LoopClosureOptions& options = {}, bool spotted = false) {
   const CameraIntrinsics intrinsics;
-  KeyframeGraph graph(intrinsics);
+  KeyframeGraph graph(intrinsics, options);
   TurnResult out;
   Rigid3 applied;  // What the corrections so far moved the object frame by.
   Rigid3 last;
   const int frames = 125;  // 3° a frame: 372°.
   for (int i = 0; i < frames; ++i) {
     const Rigid3 truth = TruePose(3.0 * i);
-    const Frame frame = test::RenderEllipsoid(intrinsics, truth, semi_axes_mm);
+    Frame frame = test::RenderEllipsoid(intrinsics, truth, semi_axes_mm);
+    if (spotted) PaintSpots(intrinsics, truth, &frame);
     std::vector<std::uint8_t> mask(frame.depth_mm.size(), 0);
     std::array<int, 4> box = {frame.width, frame.height, 0, 0};
     for (int v = 0; v < frame.height; ++v) {
@@ -90,7 +124,7 @@ TurnResult TurnWithDrift(const Eigen::Vector3d& semi_axes_mm) {
       }
     }
     const Rigid3 tracked = truth * Drift(i) * applied;
-    const KeyframeUpdate update = graph.Observe(frame, mask, box, tracked, i);
+    const KeyframeUpdate update = graph.Observe(frame, mask, box, tracked, i, 1.0, spotted);
     last = tracked;
     out.loops += update.loops;
     if (update.corrected) {
@@ -128,6 +162,25 @@ TEST(KeyframeGraphTest, ABallClosesNoLoopItsTurnIsNotSeenInItsShape) {
   EXPECT_EQ(turn.corrections, 0);
 }
 
+TEST(KeyframeGraphTest, ASpottedBallsTurnIsClosedByItsKeypointsWhereTheyAreOn) {
+  // Its shape shows nothing of the turn; its spots do.
+  LoopClosureOptions on;
+  on.feature_loops = true;
+  const TurnResult with = TurnWithDrift({35, 35, 35}, on, true);
+  const TurnResult without = TurnWithDrift({35, 35, 35}, {}, true);
+  std::printf(
+      "spotted ball: drift at the end %.1f mm, %.2f mm with keypoint loops (%d loops, "
+      "%d corrections, worst keyframe %.2f mm), %.1f mm without (%d loops)\n",
+      with.drifted_end_mm, with.end_error_mm, with.loops, with.corrections, with.worst_keyframe_mm,
+      without.end_error_mm, without.loops);
+  EXPECT_EQ(without.loops, 0);
+  EXPECT_GT(with.loops, 0);
+  EXPECT_GE(with.corrections, 1);
+  EXPECT_GT(with.drifted_end_mm, 15.0);
+  EXPECT_LT(with.end_error_mm, 3.0);
+  EXPECT_LT(with.worst_keyframe_mm, 0.5 * with.drifted_end_mm);
+}
+
 TEST(KeyframeGraphTest, CorrectionsAreInterpolatedBetweenKeyframes) {
   std::vector<Keyframe> keyframes(2);
   keyframes[0].stamp = 10;
@@ -144,6 +197,12 @@ TEST(LoopClosureOptionsTest, BadValuesAreNamed) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
   options = {};
   options.loop_max_turn_deg = 95;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options = {};
+  options.feature_max_rival = 1.5;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options = {};
+  options.feature_min_inliers = 2;
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
