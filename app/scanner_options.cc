@@ -260,6 +260,11 @@ void AddLoopClosureOptions(OptionRegistry& r, fusion::LoopClosureOptions* option
         "motions turned more than this from the loop's are its rivals, degrees");
   r.Add("fusion.loop_closure.feature_max_rival", &l.feature_max_rival,
         "no loop where a rival explains more than this share of the loop's matches");
+  r.Add("fusion.loop_closure.feature_drift_share", &l.feature_drift_share,
+        "a loop by keypoints turns the chain by at most this share of the turn it travelled "
+        "since the earlier keyframe ...");
+  r.Add("fusion.loop_closure.feature_min_gate_deg", &l.feature_min_gate_deg,
+        "... or this many degrees");
 }
 
 }  // namespace

@@ -77,6 +77,9 @@ void LoopClosureOptions::Check() const {
                 "fusion.loop_closure.feature_inlier_mm and feature_distinct_deg must be positive");
   IHS_CHECK_ARG(feature_max_rival >= 0 && feature_max_rival <= 1,
                 "fusion.loop_closure.feature_max_rival must be in [0, 1]");
+  IHS_CHECK_ARG(feature_drift_share > 0 && feature_min_gate_deg >= 0,
+                "fusion.loop_closure.feature_drift_share must be positive, feature_min_gate_deg "
+                ">= 0");
   graph.Check();
 }
 
@@ -180,9 +183,16 @@ int KeyframeGraph::AddConfirmedLoops(bool by_keypoints) {
   const int newest = static_cast<int>(keyframes_.size()) - 1;
   std::vector<Loop> found;
   for (int earlier : by_keypoints ? KeypointCandidates() : LoopCandidates()) {
-    const std::optional<Rigid3> motion =
+    std::optional<Rigid3> motion =
         by_keypoints ? RegisterByKeypoints(keyframes_[newest], keyframes_[earlier])
                      : Register(keyframes_[newest], keyframes_[earlier]);
+    if (motion && by_keypoints) {
+      // Within the drift the chain can have gathered since the earlier keyframe.
+      const double gate = std::max(options_.feature_min_gate_deg,
+                                   options_.feature_drift_share * Travelled(earlier, newest));
+      const Rigid3 registered = motion->Inverse() * keyframes_[earlier].cam_from_object;
+      if (TurnDeg(registered, keyframes_[newest].cam_from_object) > gate) motion.reset();
+    }
     if (motion) {
       found.push_back({{newest, earlier, *motion, 1.0},
                        motion->Inverse() * keyframes_[earlier].cam_from_object,
@@ -310,6 +320,13 @@ std::optional<Rigid3> KeyframeGraph::RegisterByKeypoints(const Keyframe& from, c
       Align(from, FitRigidTransform(a, b), &icp_inliers, /*free_allowed=*/true);
   if (!motion || !Plausible(*motion, from, to)) return std::nullopt;
   return motion;
+}
+
+double KeyframeGraph::Travelled(int from, int to) const {
+  double travelled = 0;
+  for (int k = from; k < to; ++k)
+    travelled += TurnDeg(keyframes_[k].cam_from_object, keyframes_[k + 1].cam_from_object);
+  return travelled;
 }
 
 bool KeyframeGraph::Plausible(const Rigid3& motion, const Keyframe& from,

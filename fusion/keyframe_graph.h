@@ -90,6 +90,13 @@ struct LoopClosureOptions {
   double feature_inlier_mm = 4.0;
   double feature_distinct_deg = 25.0;
   double feature_max_rival = 0.5;
+  /// A loop by keypoints may turn the chain's estimate of the newest keyframe by at most this
+  /// share of the turn the chain travelled between the two keyframes (the sum of its steps),
+  /// and at least `feature_min_gate_deg`: the turn the hand carries drifts as it goes (scans
+  /// that follow a whole turn end 2-56° off after 300-360°), while a pattern that repeats (a
+  /// checkerboard every 60°) matches a view a period away long before a drift that large.
+  double feature_drift_share = 0.25;
+  double feature_min_gate_deg = 5.0;
   PoseGraphOptions graph;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -161,6 +168,8 @@ class KeyframeGraph {
   /// Their matches place `from` (RANSAC), ICP of the views from there fixes what the shapes
   /// fix and leaves the turn they leave free where the keypoints put it.
   std::optional<Rigid3> RegisterByKeypoints(const Keyframe& from, const Keyframe& to);
+  // The turn the chain travelled from keyframe `from` to `to` (the sum of its steps), degrees.
+  double Travelled(int from, int to) const;
 
  private:
   // The keyframe of a fused frame.
