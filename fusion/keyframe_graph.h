@@ -10,9 +10,10 @@
 //
 // A loop is taken from a registration of the shapes only where it fixes every direction: a ball
 // or a bottle turned about its axis looks the same from every side of the turn, so there its
-// loop says nothing about the turn. There the keyframes' SIFT keypoints are registered instead
-// where the object has colour (a label): the turn the hand carried drifts by tens of degrees
-// over a whole turn, and its pattern shows where the object really is.
+// loop says nothing about the turn. There the keyframes' SIFT keypoints can be registered
+// instead where the object has colour (a label; LoopClosureOptions::feature_loops, off): the
+// turn the hand carried drifts by tens of degrees over a whole turn, and its pattern shows
+// where the object really is — unless the pattern repeats.
 
 #include <Eigen/Core>
 #include <array>
@@ -163,15 +164,15 @@ class KeyframeGraph {
   /// points on the second's surface, starting from their poses; none where that is not a
   /// loop (see LoopClosureOptions).
   std::optional<Rigid3> Register(const Keyframe& from, const Keyframe& to);
-  /// The same motion from the two keyframes' keypoints (see LoopClosureOptions::feature_loops);
-  /// none where they do not make it a loop.
-  /// Their matches place `from` (RANSAC), ICP of the views from there fixes what the shapes
-  /// fix and leaves the turn they leave free where the keypoints put it.
+  /// The same motion from the two keyframes' keypoints (see LoopClosureOptions::feature_loops):
+  /// their matches place `from` (RANSAC), ICP of the views from there fixes what the shapes fix
+  /// and leaves the turn they leave free where the keypoints put it; none where they do not
+  /// make it a loop.
   std::optional<Rigid3> RegisterByKeypoints(const Keyframe& from, const Keyframe& to);
-  // The turn the chain travelled from keyframe `from` to `to` (the sum of its steps), degrees.
-  double Travelled(int from, int to) const;
 
  private:
+  // The turn the chain travelled from keyframe `from` to `to` (the sum of its steps), degrees.
+  double Travelled(int from, int to) const;
   // The keyframe of a fused frame.
   Keyframe Keep(const Frame& frame, const std::vector<std::uint8_t>& mask,
                 const std::array<int, 4>& box, const Rigid3& cam_from_object, int stamp) const;
