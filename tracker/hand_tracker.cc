@@ -56,6 +56,9 @@ void TrackerOptions::Check() const {
   IHS_CHECK_ARG(search_data_coverage >= min_data_coverage && search_data_coverage <= 1,
                 "tracker.search_data_coverage must be in [min_data_coverage, 1]");
   IHS_CHECK_ARG(doubtful_frames_to_search >= 1, "tracker.doubtful_frames_to_search must be >= 1");
+  IHS_CHECK_ARG(search_when_points_grow == 0 || search_when_points_grow > 1,
+                "tracker.search_when_points_grow must be 0 or > 1");
+  IHS_CHECK_ARG(search_growth_gain >= 1, "tracker.search_growth_gain must be >= 1");
   IHS_CHECK_ARG(initialisation_iterations >= 1 && initialisation_iterations <= 100,
                 "tracker.initialisation_iterations must be in [1, 100]");
   IHS_CHECK_ARG(search_coarse_iterations >= 1 && search_coarse_iterations <= 100,
@@ -110,6 +113,7 @@ struct HandTracker::PendingSearch {
   std::future<HandFitResult> found;
   Rigid3 cam_from_root;
   std::int64_t frame_index = 0;
+  double gain = 1.0;  // How many times better the found pose must score.
 };
 
 struct HandTracker::PendingFlipCheck {
@@ -331,8 +335,9 @@ HandFitResult HandTracker::Search(const SearchStarts& search_starts,
 }
 
 void HandTracker::StartSearchBeside(const Frame& frame, const TrackResult& result,
-                                    const std::optional<GraspSide>& side) {
+                                    const std::optional<GraspSide>& side, double gain) {
   auto pending = std::make_unique<PendingSearch>();
+  pending->gain = gain;
   pending->cam_from_root = result.fit.pose.cam_from_root;
   pending->frame_index = frame.index;
   // Copies: the frame and its segmentation outlive this call only here.
@@ -350,12 +355,12 @@ void HandTracker::WeighSearchBeside(const Frame& frame, TrackResult& result,
   HandFitResult found = pending->found.get();
   if (found.data_points == 0) return;  // No hand points: nothing was found.
   TakeMovedOn("the search", found.pose, pending->cam_from_root, pending->frame_index, frame, result,
-              side);
+              side, pending->gain);
 }
 
 bool HandTracker::TakeMovedOn(const char* what, const HandPose& found, const Rigid3& then_root,
                               std::int64_t then_frame, const Frame& frame, TrackResult& result,
-                              const GraspSide* side) const {
+                              const GraspSide* side, double gain) const {
   // Moved on as the tracked root moved since.
   HandPose start = found;
   start.cam_from_root = result.fit.pose.cam_from_root * then_root.Inverse() * found.cam_from_root;
@@ -363,7 +368,7 @@ bool HandTracker::TakeMovedOn(const char* what, const HandPose& found, const Rig
       initial_fitter_->Fit(result.segmentation.hand_points, &frame, start, &result.segmentation);
   spdlog::debug("frame {}: {} begun at frame {} scores {:.2f}, the tracked fit {:.2f}", frame.index,
                 what, then_frame, Score(fit, side), Score(result.fit, side));
-  if (!(Score(fit, side) < Score(result.fit, side))) return false;
+  if (!(gain * Score(fit, side) < Score(result.fit, side))) return false;
   result.fit = std::move(fit);
   result.status = TrackStatus::kInitialised;
   return true;
@@ -522,6 +527,7 @@ TrackResult HandTracker::Track(const Frame& frame) {
   if (!has_pose_) {
     result.fit = Search(StartsOfSearch(), points, frame, &result.segmentation, side());
     result.status = TrackStatus::kInitialised;
+    points_at_search_ = points.size();
   } else {
     HandPose predicted = pose_;
     if (has_previous_) {
@@ -545,15 +551,25 @@ TrackResult HandTracker::Track(const Frame& frame) {
   // the tracking from the next frames on).
   doubtful_in_a_row_ =
       result.fit.data_coverage < options_.search_data_coverage ? doubtful_in_a_row_ + 1 : 0;
-  if (result.status == TrackStatus::kTracked &&
-      doubtful_in_a_row_ >= options_.doubtful_frames_to_search) {
+  // Or, touching nothing, the hand shows much more of itself than on any frame searched.
+  if (points_at_search_ == 0) points_at_search_ = points.size();
+  const bool grown = options_.search_when_points_grow > 0 && previous_contact_bones_.empty() &&
+                     static_cast<double>(points.size()) >=
+                         options_.search_when_points_grow * static_cast<double>(points_at_search_);
+  const bool doubted = doubtful_in_a_row_ >= options_.doubtful_frames_to_search;
+  if (result.status == TrackStatus::kTracked && (doubted || grown)) {
     doubtful_in_a_row_ = 0;
+    points_at_search_ = std::max(points_at_search_, points.size());
+    // A doubtful fit gives way to any better pose, a trusted one only to a much better one.
+    const double gain = doubted ? 1.0 : options_.search_growth_gain;
     if (options_.search_beside) {
       side();  // Finds the held object (`held`) once.
-      if (!pending_) StartSearchBeside(frame, result, held);
+      if (!pending_) StartSearchBeside(frame, result, held, gain);
     } else {
       HandFitResult found = Search(StartsOfSearch(), points, frame, &result.segmentation, side());
-      if (Score(found, side()) < Score(result.fit, side())) {
+      spdlog::debug("frame {}: the search scores {:.2f}, the tracked fit {:.2f}", frame.index,
+                    Score(found, side()), Score(result.fit, side()));
+      if (gain * Score(found, side()) < Score(result.fit, side())) {
         result.fit = std::move(found);
         result.status = TrackStatus::kInitialised;
       }
