@@ -299,8 +299,8 @@ void AddTrackerOptions(OptionRegistry& r, tracker::TrackerOptions* options) {
   r.Add("tracker.doubtful_frames_to_search", &t.doubtful_frames_to_search,
         "doubtful frames in a row before searching for the hand anew from the hand cloud");
   r.Add("tracker.search_when_points_grow", &t.search_when_points_grow,
-        "search anew when a frame shows this many times the hand points of the last search (0: "
-        "never)");
+        "search anew, while the hand touches nothing, on a frame with this many times the hand "
+        "points of every frame searched before (0: never)");
   r.Add("tracker.search_growth_gain", &t.search_growth_gain,
         "how many times better a search started by more hand points must score to be taken");
   r.Add("tracker.search.directions", &t.search.directions,
