@@ -126,6 +126,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["feature_loops"] = fused.feature_loops;
       feature_loops_ += fused.feature_loops;
     }
+    if (fused.keypoint_alias_deg > 0) keypoint_alias_deg_ = fused.keypoint_alias_deg;
     if (fused.loop_correction_mm > 0) {
       entry["loop_correction_mm"] = fused.loop_correction_mm;
       entry["refuse_ms"] = fused.refuse_ms;
@@ -181,6 +182,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"keyframes", keyframes_},
                             {"loops", loops_},
                             {"feature_loops", feature_loops_},
+                            {"keypoint_alias_deg", keypoint_alias_deg_},
                             {"loop_corrections", loop_corrections_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},

@@ -78,6 +78,8 @@ class ScanRecord {
   std::int64_t keyframes_ = 0;
   std::int64_t loops_ = 0;
   std::int64_t feature_loops_ = 0;
+  // The last FusionResult::keypoint_alias_deg (0: none).
+  double keypoint_alias_deg_ = 0;
   std::int64_t loop_corrections_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;

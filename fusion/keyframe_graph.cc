@@ -77,6 +77,11 @@ void LoopClosureOptions::Check() const {
                 "fusion.loop_closure.feature_inlier_mm and feature_distinct_deg must be positive");
   IHS_CHECK_ARG(feature_max_rival >= 0 && feature_max_rival <= 1,
                 "fusion.loop_closure.feature_max_rival must be in [0, 1]");
+  IHS_CHECK_ARG(feature_min_inlier_fraction > 0 && feature_min_inlier_fraction <= 1,
+                "fusion.loop_closure.feature_min_inlier_fraction must be in (0, 1]");
+  IHS_CHECK_ARG(spin_axis_min_deg > 0, "fusion.loop_closure.spin_axis_min_deg must be positive");
+  IHS_CHECK_ARG(feature_alias_share > 0,
+                "fusion.loop_closure.feature_alias_share must be positive");
   IHS_CHECK_ARG(feature_drift_share > 0 && feature_min_gate_deg >= 0,
                 "fusion.loop_closure.feature_drift_share must be positive, feature_min_gate_deg "
                 ">= 0");
@@ -144,6 +149,7 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
     return update;
   }
   const bool by_keypoints = turn_free && options_.feature_loops;
+  turn_free_ = turn_free;
   keyframes_.push_back(Keep(frame, mask, box, cam_from_object, stamp));
   if (by_keypoints) {
     SiftOptions sift;
@@ -172,7 +178,7 @@ void KeyframeGraph::AddChainEdge() {
   edges_.push_back(
       {newest - 1, newest,
        keyframes_[newest].cam_from_object * keyframes_[newest - 1].cam_from_object.Inverse(),
-       std::pow(trust, 4)});
+       std::pow(trust, 4), turn_free_});
 }
 
 int KeyframeGraph::AddConfirmedLoops(bool by_keypoints) {
@@ -182,22 +188,16 @@ int KeyframeGraph::AddConfirmedLoops(bool by_keypoints) {
   // it is not (a cube's faces are alike) rarely does so twice alike.
   const int newest = static_cast<int>(keyframes_.size()) - 1;
   std::vector<Loop> found;
-  for (int earlier : by_keypoints ? KeypointCandidates() : LoopCandidates()) {
-    std::optional<Rigid3> motion =
-        by_keypoints ? RegisterByKeypoints(keyframes_[newest], keyframes_[earlier])
-                     : Register(keyframes_[newest], keyframes_[earlier]);
-    if (motion && by_keypoints) {
-      // Within the drift the chain can have gathered since the earlier keyframe.
-      const double gate = std::max(options_.feature_min_gate_deg,
-                                   options_.feature_drift_share * Travelled(earlier, newest));
-      const Rigid3 registered = motion->Inverse() * keyframes_[earlier].cam_from_object;
-      if (TurnDeg(registered, keyframes_[newest].cam_from_object) > gate) motion.reset();
-    }
-    if (motion) {
+  if (by_keypoints) {
+    found = KeypointLoops();
+  } else {
+    for (int earlier : LoopCandidates()) {
+      const std::optional<Rigid3> motion = Register(keyframes_[newest], keyframes_[earlier]);
+      if (!motion) continue;
       found.push_back({{newest, earlier, *motion, 1.0},
                        motion->Inverse() * keyframes_[earlier].cam_from_object,
                        false,
-                       by_keypoints});
+                       false});
     }
   }
   std::vector<Loop*> all;
@@ -221,7 +221,19 @@ int KeyframeGraph::AddConfirmedLoops(bool by_keypoints) {
   int added = 0;
   feature_loops_ = 0;
   std::vector<Loop> still_pending;
-  for (const Loop* loop : all) {
+  for (size_t i = 0; i < all.size(); ++i) {
+    const Loop* loop = all[i];
+    if (loop->confirmed && loop->by_keypoints && options_.spin_axis_loops) {
+      // The correction this loop asks of the newest keyframe turns about the object's spin axis.
+      const Rigid3 correction = keyframes_[newest].cam_from_object.Inverse() * placed[i];
+      const double deg = correction.RotationAngleToRad(Rigid3()) * 180.0 / M_PI;
+      if (deg > spin_axis_deg_) {
+        if (std::optional<SpinAxis> axis = ScrewAxis(correction, options_.spin_axis_min_deg)) {
+          spin_axis_ = axis;
+          spin_axis_deg_ = deg;
+        }
+      }
+    }
     if (loop->confirmed) {
       edges_.push_back(loop->edge);
       ++added;
@@ -263,6 +275,40 @@ Keyframe KeyframeGraph::Keep(const Frame& frame, const std::vector<std::uint8_t>
     }
   }
   return kept;
+}
+
+std::vector<KeyframeGraph::Loop> KeyframeGraph::KeypointLoops() {
+  const int newest = static_cast<int>(keyframes_.size()) - 1;
+  const Rigid3& chain = keyframes_[newest].cam_from_object;
+  std::vector<Loop> found;
+  for (int earlier : KeypointCandidates()) {
+    const std::optional<Rigid3> motion =
+        RegisterByKeypoints(keyframes_[newest], keyframes_[earlier]);
+    if (!motion) continue;
+    const Rigid3 placed = motion->Inverse() * keyframes_[earlier].cam_from_object;
+    // Within the drift the chain can have gathered since the earlier keyframe; past it, a view
+    // matched to a copy of its pattern.
+    const double gate = std::max(options_.feature_min_gate_deg,
+                                 options_.feature_drift_share * Travelled(earlier, newest));
+    const double correction = TurnDeg(placed, chain);
+    if (correction > gate) {
+      alias_deg_ = std::min(alias_deg_, correction);
+      continue;
+    }
+    for (const Loop& other : found) {
+      const double apart = TurnDeg(placed, other.placed);
+      if (apart > options_.feature_distinct_deg) {
+        alias_deg_ = std::min(alias_deg_, apart);
+      }
+    }
+    found.push_back({{newest, earlier, *motion, 1.0}, placed, false, true});
+  }
+  // Half a period or more from the chain, a loop is as near a copy's view as its own: of
+  // registrations that disagree, those nearest the chain are kept.
+  std::erase_if(found, [&](const Loop& loop) {
+    return TurnDeg(loop.placed, chain) >= options_.feature_alias_share * alias_deg_;
+  });
+  return found;
 }
 
 std::vector<int> KeyframeGraph::LoopCandidates() const {
@@ -419,9 +465,10 @@ std::optional<Rigid3> KeyframeGraph::Align(const Keyframe& from, const Rigid3& s
     if (!result.ok) return std::nullopt;
     motion = result.cam_from_volume.Inverse() * motion;
   }
+  const double min_fraction =
+      free_allowed ? options_.feature_min_inlier_fraction : options_.min_inlier_fraction;
   if ((result.free_directions > 0 && !free_allowed) ||
-      result.inliers < options_.min_inlier_fraction * from.points.size() ||
-      result.rms_mm > options_.max_rms_mm) {
+      result.inliers < min_fraction * from.points.size() || result.rms_mm > options_.max_rms_mm) {
     return std::nullopt;
   }
   *inliers = result.inliers;
@@ -431,7 +478,7 @@ std::optional<Rigid3> KeyframeGraph::Align(const Keyframe& from, const Rigid3& s
 void KeyframeGraph::Solve(KeyframeUpdate* update) {
   std::vector<Rigid3> poses;
   for (const Keyframe& keyframe : keyframes_) poses.push_back(keyframe.cam_from_object);
-  const std::vector<Rigid3> solved = SolvePoseGraph(poses, edges_, options_.graph);
+  const std::vector<Rigid3> solved = SolvePoseGraph(poses, edges_, options_.graph, spin_axis_);
   for (size_t i = 0; i < poses.size(); ++i) {
     update->correction_mm = std::max(update->correction_mm,
                                      PoseDistanceMm(poses[i], solved[i], options_.graph.lever_mm));

@@ -10,14 +10,17 @@
 //
 // A loop is taken from a registration of the shapes only where it fixes every direction: a ball
 // or a bottle turned about its axis looks the same from every side of the turn, so there its
-// loop says nothing about the turn. There the keyframes' SIFT keypoints can be registered
-// instead where the object has colour (a label; LoopClosureOptions::feature_loops, off): the
-// turn the hand carried drifts by tens of degrees over a whole turn, and its pattern shows
-// where the object really is — unless the pattern repeats.
+// loop says nothing about the turn. There the keyframes' SIFT keypoints are registered instead
+// where the object has colour (a label; LoopClosureOptions::feature_loops): the turn the hand
+// carried drifts by tens of degrees over a whole turn, and its pattern shows where the object
+// really is — unless the pattern repeats (then only loops within half a period of the chain
+// count), and the correction goes into spins about the object's axis, which its shape and the
+// chain fixed (a correction spread as shifts and tilts too would smear the re-fused model).
 
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -83,7 +86,7 @@ struct LoopClosureOptions {
   /// `feature_max_rival` of their number (a pattern that repeats round the object, as a
   /// checkerboard does every 60°, lets two motions explain the matches). Such loops are
   /// confirmed by a second one as every loop is.
-  bool feature_loops = false;
+  bool feature_loops = true;
   int feature_keypoints = 150;
   double feature_max_turn_deg = 90.0;
   int feature_tries = 4;
@@ -98,6 +101,25 @@ struct LoopClosureOptions {
   /// checkerboard every 60°) matches a view a period away long before a drift that large.
   double feature_drift_share = 0.25;
   double feature_min_gate_deg = 5.0;
+  /// A pattern that repeats shows itself: a registration by keypoints that turns the chain's
+  /// estimate past the drift gate above, or two registrations of one new keyframe that place
+  /// it more than `feature_distinct_deg` apart, is a view matched to a copy of its pattern
+  /// (the least such turn seen so far is the period's estimate). From then on a loop by
+  /// keypoints may turn the chain's estimate by less than this share of that turn (half a
+  /// period: farther, a loop is as near its neighbour's alias as its own view; of a keyframe's
+  /// registrations that disagree, those nearest the chain are kept).
+  double feature_alias_share = 0.5;
+  /// Where the surface leaves the turn free, the chain's steps measured everything but the
+  /// object's spin well (its shape fixed the rest): the pose graph then spreads a loop's
+  /// correction as spins about the line the largest correction so far turned about (its screw
+  /// axis, once at least `spin_axis_min_deg`), holding that line (PoseGraphOptions::
+  /// spin_weight), instead of as shifts and tilts that smear the re-fused model.
+  bool spin_axis_loops = true;
+  double spin_axis_min_deg = 5.0;
+  /// A loop by keypoints: ICP of the two views from where the keypoints put them pairs at
+  /// least this share of the new keyframe's points (views up to `feature_max_turn_deg` apart
+  /// overlap less than a shape loop's views within `loop_max_turn_deg`).
+  double feature_min_inlier_fraction = 0.25;
   PoseGraphOptions graph;
 
   /// Throws std::invalid_argument naming the bad field.
@@ -155,6 +177,9 @@ class KeyframeGraph {
                          double kept_pairs = 1.0, bool turn_free = false);
 
   const std::vector<Keyframe>& keyframes() const { return keyframes_; }
+  /// The least turn a registration by keypoints was seen to be off by (a pattern's period,
+  /// see LoopClosureOptions::feature_alias_share), degrees; infinite where none was.
+  double alias_deg() const { return alias_deg_; }
   /// How the object frame of a frame with `stamp` moved in the last correction: the
   /// correction of the keyframes around it, interpolated by stamp.
   static Rigid3 CorrectionAt(const std::vector<Keyframe>& keyframes,
@@ -171,6 +196,14 @@ class KeyframeGraph {
   std::optional<Rigid3> RegisterByKeypoints(const Keyframe& from, const Keyframe& to);
 
  private:
+  // A loop waiting for another to agree with it: its edge, where it puts its keyframe's
+  // object (cam_from_object) and whether one did.
+  struct Loop {
+    PoseGraphEdge edge;
+    Rigid3 placed;
+    bool confirmed = false;
+    bool by_keypoints = false;
+  };
   // The turn the chain travelled from keyframe `from` to `to` (the sum of its steps), degrees.
   double Travelled(int from, int to) const;
   // The keyframe of a fused frame.
@@ -181,12 +214,16 @@ class KeyframeGraph {
   // the surfaces leave directions free (they stay where `start` put them).
   std::optional<Rigid3> Align(const Keyframe& from, const Rigid3& start, int* inliers,
                               bool free_allowed = false) const;
-  // The newest keyframe's edge to the one before: the tracked motion, weighed by chain_kept_.
+  // The newest keyframe's edge to the one before: the tracked motion, weighed by chain_kept_
+  // (spin-free where the surface leaves the turn free).
   void AddChainEdge();
   // Registers the newest keyframe against earlier ones (by keypoints: `by_keypoints`), adds the
   // loops that a second one confirms (its own or pending ones) to the graph and returns how
-  // many.
+  // many; a confirmed loop by keypoints may set spin_axis_.
   int AddConfirmedLoops(bool by_keypoints);
+  // The newest keyframe's loops by keypoints with the earlier keyframes, less those a
+  // repeating pattern may have placed (LoopClosureOptions::feature_alias_share).
+  std::vector<Loop> KeypointLoops();
   // The earlier keyframes the newest one is tried against, nearest turn first.
   std::vector<int> LoopCandidates() const;
   // Those it is tried against by keypoints, most matches first.
@@ -204,19 +241,21 @@ class KeyframeGraph {
   IcpOptions icp_;
   std::vector<Keyframe> keyframes_;
   std::vector<PoseGraphEdge> edges_;
-  // A loop waiting for another to agree with it: its edge, where it puts its keyframe's
-  // object (cam_from_object) and whether one did.
-  struct Loop {
-    PoseGraphEdge edge;
-    Rigid3 placed;
-    bool confirmed = false;
-    bool by_keypoints = false;
-  };
   std::vector<Loop> pending_;
   // The least share of its first pairs a frame's ICP kept since the last keyframe.
   double chain_kept_ = 1.0;
   // Loops registered by keypoints among those the last AddConfirmedLoops confirmed.
   int feature_loops_ = 0;
+  // The least turn (degrees) a registration by keypoints was seen to be off by where the
+  // pattern repeats (LoopClosureOptions::feature_alias_share); infinite before.
+  double alias_deg_ = std::numeric_limits<double>::infinity();
+  // The line the largest loop correction by keypoints turned about (object frame), and by how
+  // much (degrees); see LoopClosureOptions::spin_axis_loops.
+  std::optional<SpinAxis> spin_axis_;
+  double spin_axis_deg_ = 0;
+  // Whether the surface left the turn free at the newest keyframe (its chain edge is then
+  // spin-free).
+  bool turn_free_ = false;
   RaycastImage scratch_;
 };
 

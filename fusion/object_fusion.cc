@@ -306,6 +306,7 @@ void ObjectFusion::CloseLoops(const ObjectPixels& object, FusionResult* result) 
   result->keyframe = update.added;
   result->loops = update.loops;
   result->feature_loops = update.feature_loops;
+  if (std::isfinite(keyframes_.alias_deg())) result->keypoint_alias_deg = keyframes_.alias_deg();
   if (update.corrected) ApplyCorrection(update, result);
 }
 

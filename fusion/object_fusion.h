@@ -207,6 +207,10 @@ struct FusionResult {
   int loops = 0;
   /// Of those, registered by the keyframes' keypoints (LoopClosureOptions::feature_loops).
   int feature_loops = 0;
+  /// The least turn a registration by keypoints was seen off by so far (a pattern that
+  /// repeats, or a drift past the gate; KeyframeGraph::alias_deg: loops by keypoints stay within
+  /// half of it), degrees; 0 where none was.
+  double keypoint_alias_deg = 0;
   double loop_correction_mm = 0;
   double refuse_ms = 0;
   /// Whether ICP started from the previous pose won over the registration's (see

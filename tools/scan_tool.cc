@@ -146,6 +146,12 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
         "times\n",
         count(summary, "keyframes"), loops, count(summary, "loop_corrections"));
   }
+  if (const double alias = summary.value("keypoint_alias_deg", 0.0); alias > 0) {
+    std::printf(
+        "  registrations by keypoints were seen %.0f° off (a pattern that repeats, or a drift "
+        "past the gate): loops by keypoints kept within half of that\n",
+        alias);
+  }
   if (const int carried = count(summary, "hand_carried_frames"),
       back = count(summary, "hand_back_frames"),
       undecided = count(summary, "hand_undecided_frames");
