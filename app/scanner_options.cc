@@ -269,13 +269,13 @@ void AddLoopClosureOptions(OptionRegistry& r, fusion::LoopClosureOptions* option
         "once a registration by keypoints was seen off by a turn (past the drift gate, or "
         "against another of the same keyframe: a pattern that repeats), loops by keypoints turn "
         "the chain by less than this share of the least such turn");
+  r.Add("fusion.loop_closure.feature_min_inlier_fraction", &l.feature_min_inlier_fraction,
+        "a loop by keypoints pairs at least this share of the new keyframe's points");
   r.Add("fusion.loop_closure.spin_axis_loops", &l.spin_axis_loops,
         "where the surface leaves the turn free, a loop's correction is spread as spins about "
         "the line the largest correction turned about");
   r.Add("fusion.loop_closure.spin_axis_min_deg", &l.spin_axis_min_deg,
         "... once a correction turned at least this far, degrees");
-  r.Add("fusion.loop_closure.feature_min_inlier_fraction", &l.feature_min_inlier_fraction,
-        "a loop by keypoints pairs at least this share of the new keyframe's points");
   r.Add("fusion.loop_closure.spin_weight", &l.graph.spin_weight,
         "... the chain's hold on that spin against its hold on the line");
 }
