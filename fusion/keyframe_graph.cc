@@ -149,7 +149,6 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
     return update;
   }
   const bool by_keypoints = turn_free && options_.feature_loops;
-  turn_free_ = turn_free;
   keyframes_.push_back(Keep(frame, mask, box, cam_from_object, stamp));
   if (by_keypoints) {
     SiftOptions sift;
@@ -161,14 +160,14 @@ KeyframeUpdate KeyframeGraph::Observe(const Frame& frame, const std::vector<std:
   }
   update.added = true;
   if (keyframes_.size() == 1) return update;
-  AddChainEdge();
+  AddChainEdge(turn_free);
   update.loops = AddConfirmedLoops(by_keypoints);
   update.feature_loops = feature_loops_;
   if (update.loops > 0) Solve(&update);
   return update;
 }
 
-void KeyframeGraph::AddChainEdge() {
+void KeyframeGraph::AddChainEdge(bool spin_free) {
   // The tracked motion from the previous keyframe, trusted less where a frame in between
   // may have slid.
   const int newest = static_cast<int>(keyframes_.size()) - 1;
@@ -178,7 +177,7 @@ void KeyframeGraph::AddChainEdge() {
   edges_.push_back(
       {newest - 1, newest,
        keyframes_[newest].cam_from_object * keyframes_[newest - 1].cam_from_object.Inverse(),
-       std::pow(trust, 4), turn_free_});
+       std::pow(trust, 4), spin_free});
 }
 
 int KeyframeGraph::AddConfirmedLoops(bool by_keypoints) {

@@ -216,7 +216,7 @@ class KeyframeGraph {
                               bool free_allowed = false) const;
   // The newest keyframe's edge to the one before: the tracked motion, weighed by chain_kept_
   // (spin-free where the surface leaves the turn free).
-  void AddChainEdge();
+  void AddChainEdge(bool spin_free);
   // Registers the newest keyframe against earlier ones (by keypoints: `by_keypoints`), adds the
   // loops that a second one confirms (its own or pending ones) to the graph and returns how
   // many; a confirmed loop by keypoints may set spin_axis_.
@@ -253,9 +253,6 @@ class KeyframeGraph {
   // much (degrees); see LoopClosureOptions::spin_axis_loops.
   std::optional<SpinAxis> spin_axis_;
   double spin_axis_deg_ = 0;
-  // Whether the surface left the turn free at the newest keyframe (its chain edge is then
-  // spin-free).
-  bool turn_free_ = false;
   RaycastImage scratch_;
 };
 
