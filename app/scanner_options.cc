@@ -172,6 +172,9 @@ void AddTsdfOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
         "signed distances truncated to this many voxels");
   r.Add("fusion.tsdf.max_weight", &u.tsdf.max_weight, "cap of a voxel's integration weight");
   r.Add("fusion.tsdf.color", &u.tsdf.color, "voxels keep a colour");
+  r.Add("fusion.tsdf.threads", &u.tsdf.threads,
+        "threads that integrate and raycast (0: one per core but the tracker thread's; at most "
+        "8); the model is the same whatever the number");
 }
 
 void AddRegistrationOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {

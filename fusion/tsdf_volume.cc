@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/check.h"
+#include "core/parallel_runs.h"
 #include "fusion/marching_cubes.h"
 
 namespace ihs::fusion {
@@ -30,6 +31,7 @@ void TsdfOptions::Check() const {
                 "tsdf.truncation_voxels must be in [1, 64], got " << truncation_voxels);
   IHS_CHECK_ARG(max_weight >= 1 && max_weight <= 65535,
                 "tsdf.max_weight must be in [1, 65535], got " << max_weight);
+  IHS_CHECK_ARG(threads >= 0, "tsdf.threads must be >= 0 (0: one per core), got " << threads);
 }
 
 TsdfVolume::TsdfVolume(TsdfOptions options)
@@ -40,7 +42,7 @@ TsdfVolume::TsdfVolume(TsdfOptions options)
       voxel_mm_(options_.size_mm / options_.resolution),
       truncation_mm_(options_.truncation_voxels * voxel_mm_),
       voxels_(static_cast<size_t>(bricks_) * bricks_ * bricks_ << (3 * kBrickShift)),
-      touched_bits_((voxels_.size() + 63) / 64, 0),
+      touched_bits_(1, Bits((voxels_.size() + 63) / 64, 0)),
       half_mm_(static_cast<float>(0.5 * options_.size_mm)),
       voxel_mm_float_(static_cast<float>(voxel_mm_)),
       mm_per_tsdf_unit_(static_cast<float>(truncation_mm_) / kTsdfScale) {
@@ -91,6 +93,31 @@ std::int64_t TsdfVolume::ObservedVoxels() const {
   return std::count_if(voxels_.begin(), voxels_.end(), [](const Voxel& v) { return v.weight > 0; });
 }
 
+int TsdfVolume::Threads(int rows) const {
+  const int wanted = options_.threads > 0 ? options_.threads : std::max(1, ThreadsFor(0) - 1);
+  return std::min({wanted, TsdfOptions::kMaxThreads, std::max(1, rows)});
+}
+
+struct TsdfVolume::IntegrationView {
+  IntegrationView(const Frame& f, const std::vector<std::uint8_t>& m, const CameraIntrinsics& c)
+      : frame(f), mask(m), intrinsics(c) {}
+  const Frame& frame;
+  const std::vector<std::uint8_t>& mask;
+  const CameraIntrinsics& intrinsics;
+  // volume_from_cam, and cam_from_volume, as floats.
+  Eigen::Matrix3f rotation;
+  Eigen::Vector3f translation;
+  Eigen::Matrix3f cam_rotation;
+  Eigen::Vector3f cam_translation;
+  float half = 0, voxel = 0, band = 0;
+  // Half-voxel samples along a ray across the band.
+  int samples = 0;
+  bool color = false;
+  bool Observed(int pixel) const {
+    return frame.depth_mm[pixel] != 0 && (mask.empty() || mask[pixel] != 0);
+  }
+};
+
 int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& mask,
                           const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume) {
   IHS_CHECK_ARG(mask.empty() || mask.size() == frame.depth_mm.size(),
@@ -99,30 +126,88 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
                 "frame " << frame.width << "x" << frame.height << " but intrinsics "
                          << intrinsics.width << "x" << intrinsics.height);
   const Rigid3 volume_from_cam = cam_from_volume.Inverse();
-  const Eigen::Matrix3f rotation = volume_from_cam.rotation().cast<float>();
-  const Eigen::Vector3f translation = volume_from_cam.translation().cast<float>();
-  const float half = static_cast<float>(0.5 * options_.size_mm);
-  const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
-  auto observed = [&](int pixel) {
-    return frame.depth_mm[pixel] != 0 && (mask.empty() || mask[pixel] != 0);
-  };
+  IntegrationView view(frame, mask, intrinsics);
+  view.rotation = volume_from_cam.rotation().cast<float>();
+  view.translation = volume_from_cam.translation().cast<float>();
+  view.cam_rotation = cam_from_volume.rotation().cast<float>();
+  view.cam_translation = cam_from_volume.translation().cast<float>();
+  view.half = static_cast<float>(0.5 * options_.size_mm);
+  view.voxel = static_cast<float>(voxel_mm_);
+  view.band = static_cast<float>(truncation_mm_);
+  view.samples = static_cast<int>(std::floor(2.0f * view.band / (0.5f * view.voxel))) + 1;
+  view.color = options_.color && frame.HasColor();
 
-  // The voxels within the band around each observed pixel's surface point, along its ray.
-  const int samples = static_cast<int>(std::floor(2.0f * band / (0.5f * voxel))) + 1;
-  // Each voxel once: a bit per voxel, set here and cleared again below.
-  std::int64_t first_word = static_cast<std::int64_t>(touched_bits_.size()), last_word = -1;
-  for (int v = 0; v < frame.height; ++v) {
+  // The voxels within the band of the observed pixels, each thread marking those of every
+  // threads-th row in bits of its own, then gathered in memory order (each voxel once).
+  const int threads = Threads(frame.height);
+  while (static_cast<int>(touched_bits_.size()) < threads)
+    touched_bits_.emplace_back(touched_bits_.front().size(), 0);
+  std::vector<std::array<std::int64_t, 2>> ranges(
+      threads, {static_cast<std::int64_t>(touched_bits_.front().size()), -1});
+  ParallelRuns(threads, threads, [&](size_t begin, size_t end) {
+    for (size_t t = begin; t < end; ++t) {
+      MarkBand(view, static_cast<int>(t), threads, touched_bits_[t].data(), &ranges[t][0],
+               &ranges[t][1]);
+    }
+  });
+  GatherMarkedWords(ranges);
+
+  // Projective update of each, the marked words split among the threads.
+  std::vector<std::array<int, 3>> lo(threads, observed_lo_), hi(threads, observed_hi_);
+  std::vector<int> updated(threads, 0);
+  const size_t words = marked_words_.size();
+  ParallelRuns(threads, threads, [&](size_t begin, size_t end) {
+    for (size_t t = begin; t < end; ++t) {
+      const size_t from = words * t / threads, to = words * (t + 1) / threads;
+      updated[t] = UpdateWords(view, marked_words_.data() + from, to - from, &lo[t], &hi[t]);
+    }
+  });
+  int total = 0;
+  for (int t = 0; t < threads; ++t) {
+    total += updated[t];
+    for (int a = 0; a < 3; ++a) {
+      observed_lo_[a] = std::min(observed_lo_[a], lo[t][a]);
+      observed_hi_[a] = std::max(observed_hi_[a], hi[t][a]);
+    }
+  }
+  return total;
+}
+
+void TsdfVolume::GatherMarkedWords(const std::vector<std::array<std::int64_t, 2>>& ranges) {
+  std::int64_t first_word = ranges[0][0], last_word = ranges[0][1];
+  for (const auto& [first, last] : ranges) {
+    first_word = std::min(first_word, first), last_word = std::max(last_word, last);
+  }
+  marked_words_.clear();
+  std::uint64_t* bits = touched_bits_.front().data();
+  for (std::int64_t w = first_word; w <= last_word; ++w) {
+    for (size_t t = 1; t < ranges.size(); ++t) {
+      if (w < ranges[t][0] || w > ranges[t][1]) continue;
+      bits[w] |= touched_bits_[t][w];
+      touched_bits_[t][w] = 0;
+    }
+    if (bits[w] != 0) marked_words_.push_back(w);
+  }
+}
+
+void TsdfVolume::MarkBand(const IntegrationView& view, int v_first, int v_step, std::uint64_t* bits,
+                          std::int64_t* first_word, std::int64_t* last_word) const {
+  const Frame& frame = view.frame;
+  // Kept in locals until the end: the threads' outputs share cache lines.
+  std::int64_t first = *first_word, last = *last_word;
+  for (int v = v_first; v < frame.height; v += v_step) {
     for (int u = 0; u < frame.width; ++u) {
       const int pixel = v * frame.width + u;
-      if (!observed(pixel)) continue;
+      if (!view.Observed(pixel)) continue;
       const Eigen::Vector3f point =
-          intrinsics.BackProject(u, v, frame.depth_mm[pixel]).cast<float>();
+          view.intrinsics.BackProject(u, v, frame.depth_mm[pixel]).cast<float>();
       const Eigen::Vector3f ray = point.normalized();
       // Half-voxel steps along the ray, in voxel units of the volume's grid.
-      const Eigen::Vector3f step = rotation * ray * 0.5f;
+      const Eigen::Vector3f step = view.rotation * ray * 0.5f;
       Eigen::Vector3f grid =
-          ((rotation * (point - band * ray) + translation).array() + half) / voxel;
-      for (int s = 0; s < samples; ++s, grid += step) {
+          ((view.rotation * (point - view.band * ray) + view.translation).array() + view.half) /
+          view.voxel;
+      for (int s = 0; s < view.samples; ++s, grid += step) {
         // Inside the cube the coordinates are non-negative: truncation is their floor.
         if (!(grid.x() >= 0 && grid.y() >= 0 && grid.z() >= 0)) continue;
         const int i = static_cast<int>(grid.x());
@@ -130,23 +215,28 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
         const int k = static_cast<int>(grid.z());
         if (i >= n_ || j >= n_ || k >= n_) continue;
         const std::int64_t index = Index(i, j, k);
-        touched_bits_[index >> 6] |= std::uint64_t{1} << (index & 63);
-        first_word = std::min(first_word, index >> 6);
-        last_word = std::max(last_word, index >> 6);
+        bits[index >> 6] |= std::uint64_t{1} << (index & 63);
+        first = std::min(first, index >> 6);
+        last = std::max(last, index >> 6);
       }
     }
   }
+  *first_word = first, *last_word = last;
+}
 
-  // Projective update of each: the distance along the ray from the voxel to the surface seen
-  // through its pixel.
-  const Eigen::Matrix3f cam_rotation = cam_from_volume.rotation().cast<float>();
-  const Eigen::Vector3f cam_translation = cam_from_volume.translation().cast<float>();
-  const bool color = options_.color && frame.HasColor();
+int TsdfVolume::UpdateWords(const IntegrationView& view, const std::int64_t* words, size_t count,
+                            std::array<int, 3>* lo, std::array<int, 3>* hi) {
+  const Frame& frame = view.frame;
+  const CameraIntrinsics& intrinsics = view.intrinsics;
+  const float band = view.band;
   int updated = 0;
-  // In memory order (the bits' order), which the caches like far better than the rays' order.
+  // Kept in locals until the end: the threads' outputs share cache lines.
+  std::array<int, 3> low = *lo, high = *hi;
+  // The distance along the ray from the voxel to the surface seen through its pixel.
   auto update = [&](std::int64_t index, int i, int j, int k) {
     const Eigen::Vector3f centre =
-        cam_rotation * Eigen::Vector3f(centres_[i], centres_[j], centres_[k]) + cam_translation;
+        view.cam_rotation * Eigen::Vector3f(centres_[i], centres_[j], centres_[k]) +
+        view.cam_translation;
     if (centre.z() <= 0) return;
     const float x = static_cast<float>(intrinsics.fx) * centre.x() / centre.z() +
                     static_cast<float>(intrinsics.cx);
@@ -156,7 +246,7 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
     if (!intrinsics.Contains(x, y)) return;
     const int u = static_cast<int>(x + 0.5f), v = static_cast<int>(y + 0.5f);
     const int pixel = v * frame.width + u;
-    if (!observed(pixel)) return;
+    if (!view.Observed(pixel)) return;
     const float along_ray = std::sqrt(centre.squaredNorm()) / centre.z();
     const float distance = (frame.depth_mm[pixel] - centre.z()) * along_ray;
     if (distance < -band) return;  // Behind the surface: not seen.
@@ -165,7 +255,7 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
     const float weight = voxel_ref.weight;
     const float mean = (voxel_ref.tsdf / kTsdfScale * weight + tsdf) / (weight + 1);
     voxel_ref.tsdf = static_cast<std::int16_t>(RoundToInt(mean * kTsdfScale));
-    if (color && std::abs(distance) < band) {
+    if (view.color && std::abs(distance) < band) {
       for (int c = 0; c < 3; ++c) {
         const float value = frame.rgb[3 * pixel + c];
         voxel_ref.rgb[c] = static_cast<std::uint8_t>(
@@ -176,8 +266,8 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
         static_cast<std::uint16_t>(std::min<int>(options_.max_weight, voxel_ref.weight + 1));
     const int ijk[3] = {i, j, k};
     for (int a = 0; a < 3; ++a) {
-      observed_lo_[a] = std::min(observed_lo_[a], ijk[a]);
-      observed_hi_[a] = std::max(observed_hi_[a], ijk[a]);
+      low[a] = std::min(low[a], ijk[a]);
+      high[a] = std::max(high[a], ijk[a]);
     }
     ++updated;
   };
@@ -185,10 +275,11 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   // brick's corner by division, its bits' (i, j) by their place in the word.
   static_assert(kBrickEdge * kBrickEdge == 64, "a bit word covers one layer of a brick");
   constexpr int layers = kBrickEdge, in_brick = kBrickEdge - 1;
-  for (std::int64_t w = first_word; w <= last_word; ++w) {
-    std::uint64_t bits = touched_bits_[w];
-    if (bits == 0) continue;
-    touched_bits_[w] = 0;
+  std::uint64_t* bits_of = touched_bits_.front().data();
+  for (size_t n = 0; n < count; ++n) {
+    const std::int64_t w = words[n];
+    std::uint64_t bits = bits_of[w];
+    bits_of[w] = 0;
     const std::int64_t brick = w / layers;
     const int i0 = static_cast<int>(brick % bricks_) << kBrickShift;
     const int j0 = static_cast<int>((brick / bricks_) % bricks_) << kBrickShift;
@@ -199,6 +290,7 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
       update(w * 64 + bit, i0 + (bit & in_brick), j0 + (bit >> kBrickShift), k);
     }
   }
+  *lo = low, *hi = high;
   return updated;
 }
 
@@ -251,6 +343,22 @@ RaycastImage TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid
   return image;
 }
 
+struct TsdfVolume::RaycastView {
+  RaycastView(const CameraIntrinsics& c, const Rigid3& v, const std::vector<std::uint16_t>* n)
+      : intrinsics(c), volume_from_cam(v), near_depth_mm(n) {}
+  const CameraIntrinsics& intrinsics;
+  const Rigid3& volume_from_cam;
+  const std::vector<std::uint16_t>* near_depth_mm;
+  // volume_from_cam's rotation and origin, cam_from_volume's rotation, as floats.
+  Eigen::Matrix3f rotation;
+  Eigen::Vector3f origin;
+  Eigen::Matrix3f to_cam;
+  float half = 0, voxel = 0, band = 0, window = 0;
+  // The observed box, and the pixels cast (exclusive ends).
+  Eigen::Vector3f box_lo, box_hi;
+  int u0 = 0, v0 = 0, u1 = 0, v1 = 0;
+};
+
 void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_volume,
                          const std::array<int, 4>& roi,
                          const std::vector<std::uint16_t>* near_depth_mm, float window_mm,
@@ -277,42 +385,67 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
     }
   }
   image.written = {0, 0, 0, 0};
-  const Rigid3 volume_from_cam = cam_from_volume.Inverse();
-  const Eigen::Matrix3f rotation = volume_from_cam.rotation().cast<float>();
-  const Eigen::Vector3f origin = volume_from_cam.translation().cast<float>();
-  const Eigen::Matrix3f to_cam = cam_from_volume.rotation().cast<float>();
-  const float half = static_cast<float>(0.5 * options_.size_mm);
-  const float voxel = static_cast<float>(voxel_mm_), band = static_cast<float>(truncation_mm_);
   // Rays are followed only through the box of observed voxels.
   const Eigen::AlignedBox3f observed = ObservedBox();
   if (observed.isEmpty()) return;  // Nothing to see yet.
-  const Eigen::Vector3f box_lo = observed.min(), box_hi = observed.max();
   IHS_CHECK_ARG(near_depth_mm == nullptr || near_depth_mm->size() == pixels,
                 "near_depth_mm has " << near_depth_mm->size() << " entries, the image " << pixels);
+  const Rigid3 volume_from_cam = cam_from_volume.Inverse();
+  RaycastView view(intrinsics, volume_from_cam, near_depth_mm);
+  view.rotation = volume_from_cam.rotation().cast<float>();
+  view.origin = volume_from_cam.translation().cast<float>();
+  view.to_cam = cam_from_volume.rotation().cast<float>();
+  view.half = static_cast<float>(0.5 * options_.size_mm);
+  view.voxel = static_cast<float>(voxel_mm_);
+  view.band = static_cast<float>(truncation_mm_);
+  view.window = window_mm;
+  view.box_lo = observed.min(), view.box_hi = observed.max();
   const bool whole = roi[2] <= roi[0] || roi[3] <= roi[1];
-  const int u0 = whole ? 0 : std::max(0, roi[0]), v0 = whole ? 0 : std::max(0, roi[1]);
-  const int u1 = whole ? image.width : std::min(image.width, roi[2]);
-  const int v1 = whole ? image.height : std::min(image.height, roi[3]);
-  image.written = {u0, v0, u1, v1};
-  for (int v = v0; v < v1; ++v) {
-    for (int u = u0; u < u1; ++u) {
-      const std::uint16_t near = near_depth_mm ? (*near_depth_mm)[v * image.width + u] : 0;
-      if (near_depth_mm && near == 0) continue;
+  view.u0 = whole ? 0 : std::max(0, roi[0]), view.v0 = whole ? 0 : std::max(0, roi[1]);
+  view.u1 = whole ? image.width : std::min(image.width, roi[2]);
+  view.v1 = whole ? image.height : std::min(image.height, roi[3]);
+  image.written = {view.u0, view.v0, view.u1, view.v1};
+  // Each thread every threads-th row (the object's rows shared alike): first every ray, then
+  // (once all hits are in) the normals.
+  const int rows = std::max(0, view.v1 - view.v0);
+  const int threads = Threads(rows);
+  for (auto pass : {&TsdfVolume::CastRows, &TsdfVolume::NormalRows}) {
+    ParallelRuns(threads, threads, [&](size_t begin, size_t end) {
+      for (size_t t = begin; t < end; ++t) {
+        (this->*pass)(view, view.v0 + static_cast<int>(t), threads, &image);
+      }
+    });
+  }
+}
+
+void TsdfVolume::CastRows(const RaycastView& view, int v_first, int v_step,
+                          RaycastImage* out) const {
+  RaycastImage& image = *out;
+  const CameraIntrinsics& intrinsics = view.intrinsics;
+  const Eigen::Matrix3f& rotation = view.rotation;
+  const Eigen::Vector3f& origin = view.origin;
+  const float voxel = view.voxel, band = view.band, half = view.half;
+  for (int v = v_first; v < view.v1; v += v_step) {
+    for (int u = view.u0; u < view.u1; ++u) {
+      const std::uint16_t near =
+          view.near_depth_mm ? (*view.near_depth_mm)[v * image.width + u] : 0;
+      if (view.near_depth_mm && near == 0) continue;
       const Eigen::Vector3f ray_cam = intrinsics.BackProject(u, v, 1.0).cast<float>();
       const Eigen::Vector3f ray = rotation * ray_cam.normalized();
       // Where the ray is inside the observed box (slabs), and the window.
       float t_near = 0, t_far = std::numeric_limits<float>::infinity();
-      if (near_depth_mm) {
+      if (view.near_depth_mm) {
         const float length = ray_cam.norm();  // Along the ray per mm of depth.
-        t_near = std::max(0.0f, (near - window_mm) * length);
-        t_far = (near + window_mm) * length;
+        t_near = std::max(0.0f, (near - view.window) * length);
+        t_far = (near + view.window) * length;
       }
       for (int a = 0; a < 3; ++a) {
         if (std::abs(ray[a]) < 1e-9f) {
-          if (origin[a] < box_lo[a] || origin[a] > box_hi[a]) t_far = -1;
+          if (origin[a] < view.box_lo[a] || origin[a] > view.box_hi[a]) t_far = -1;
           continue;
         }
-        float t0 = (box_lo[a] - origin[a]) / ray[a], t1 = (box_hi[a] - origin[a]) / ray[a];
+        float t0 = (view.box_lo[a] - origin[a]) / ray[a],
+              t1 = (view.box_hi[a] - origin[a]) / ray[a];
         if (t0 > t1) std::swap(t0, t1);
         t_near = std::max(t_near, t0), t_far = std::min(t_far, t1);
       }
@@ -346,15 +479,23 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
       }
     }
   }
+}
+
+void TsdfVolume::NormalRows(const RaycastView& view, int v_first, int v_step,
+                            RaycastImage* out) const {
   // Normals from the hits' neighbours (as KinectFusion does): central differences of the
   // surface points across the pixel, one-sided at the hits' edge; neighbours across a depth step
   // of more than the truncation band lie on another surface. Where a pixel has no neighbour
   // along a direction, the signed distance's central-difference gradient gives its normal.
+  RaycastImage& image = *out;
+  const CameraIntrinsics& intrinsics = view.intrinsics;
+  const int u0 = view.u0, v0 = view.v0, u1 = view.u1, v1 = view.v1;
+  const float voxel = view.voxel, band = view.band;
   auto surface_point = [&](int u, int v) -> Eigen::Vector3f {
     return intrinsics.BackProject(u, v, image.depth_mm[static_cast<size_t>(v) * image.width + u])
         .cast<float>();
   };
-  for (int v = v0; v < v1; ++v) {
+  for (int v = v_first; v < view.v1; v += v_step) {
     for (int u = u0; u < u1; ++u) {
       const size_t pixel = static_cast<size_t>(v) * image.width + u;
       const float depth = image.depth_mm[pixel];
@@ -381,7 +522,7 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
           continue;
         }
       }
-      const Eigen::Vector3f point = volume_from_cam * surface_point(u, v);
+      const Eigen::Vector3f point = view.volume_from_cam * surface_point(u, v);
       Eigen::Vector3f gradient;
       bool ok = true;
       for (int a = 0; a < 3 && ok; ++a) {
@@ -391,7 +532,7 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
         ok = SignedDistance(point + step, &plus) && SignedDistance(point - step, &minus);
         gradient[a] = plus - minus;
       }
-      if (ok && gradient.norm() > 1e-6f) image.normals[pixel] = to_cam * gradient.normalized();
+      if (ok && gradient.norm() > 1e-6f) image.normals[pixel] = view.to_cam * gradient.normalized();
     }
   }
 }

@@ -151,6 +151,56 @@ TEST(TsdfVolumeTest, RaycastIntoAReusedImageEqualsAFreshOne) {
   EXPECT_LT(hits, 3 * first_hits / 4);
 }
 
+// Integration and raycasting split the rows (and the marked voxels) among threads; each voxel
+// and pixel is computed by one thread as it would be alone: the model, its mesh and its
+// raycasts are the same to the bit with one thread, two or seven (more than the rows of a
+// small window, with a window of one row among them).
+TEST(TsdfVolumeTest, TheModelAndItsRaycastsAreTheSameWhateverTheThreads) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  std::vector<TsdfVolume> volumes;
+  volumes.reserve(3);
+  for (int threads : {1, 2, 7}) {
+    TsdfOptions options;
+    options.resolution = 128;  // 17 MB each.
+    options.threads = threads;
+    volumes.emplace_back(options);
+  }
+  for (const Rigid3& view : test::ViewsAround(600)) {
+    const Frame frame = RenderSphere(intrinsics, view);
+    const int updated = volumes[0].Integrate(frame, {}, intrinsics, view);
+    ASSERT_GT(updated, 1000);
+    for (size_t n = 1; n < volumes.size(); ++n)
+      ASSERT_EQ(volumes[n].Integrate(frame, {}, intrinsics, view), updated);
+  }
+  const TriangleMesh mesh = volumes[0].ExtractMesh();
+  const Rigid3 seen =
+      Rigid3::Translation({12, -4, 580}) * Rigid3::FromAxisAngle(Eigen::Vector3d(1, 1, 0), 0.4);
+  for (const std::array<int, 4>& roi :
+       {std::array<int, 4>{0, 0, 0, 0}, {290, 180, 350, 300}, {300, 240, 340, 241}}) {
+    const RaycastImage alone = volumes[0].Raycast(intrinsics, seen, roi);
+    int hits = 0;
+    for (float depth : alone.depth_mm) hits += depth > 0;
+    EXPECT_GT(hits, 0);
+    for (size_t n = 1; n < volumes.size(); ++n) {
+      const RaycastImage split = volumes[n].Raycast(intrinsics, seen, roi);
+      EXPECT_EQ(split.written, alone.written);
+      EXPECT_EQ(split.depth_mm, alone.depth_mm);
+      EXPECT_EQ(split.normals, alone.normals);
+      EXPECT_EQ(split.colors, alone.colors);
+    }
+  }
+  for (size_t n = 1; n < volumes.size(); ++n) {
+    EXPECT_EQ(volumes[n].ObservedVoxels(), volumes[0].ObservedVoxels());
+    EXPECT_TRUE(volumes[n].ObservedBox().isApprox(volumes[0].ObservedBox()));
+    const TriangleMesh other = volumes[n].ExtractMesh();
+    EXPECT_EQ(other.vertices, mesh.vertices);
+    EXPECT_EQ(other.faces, mesh.faces);
+  }
+  TsdfOptions bad;
+  bad.threads = -1;
+  EXPECT_THROW(TsdfVolume{bad}, std::invalid_argument);
+}
+
 TEST(TsdfVolumeTest, MaskedPixelsAloneAreIntegratedAndBadInputIsRefused) {
   const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
   const Rigid3 view = Rigid3::Translation({0, 0, 600});
