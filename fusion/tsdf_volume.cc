@@ -31,7 +31,8 @@ void TsdfOptions::Check() const {
                 "tsdf.truncation_voxels must be in [1, 64], got " << truncation_voxels);
   IHS_CHECK_ARG(max_weight >= 1 && max_weight <= 65535,
                 "tsdf.max_weight must be in [1, 65535], got " << max_weight);
-  IHS_CHECK_ARG(threads >= 0, "tsdf.threads must be >= 0 (0: one per core), got " << threads);
+  IHS_CHECK_ARG(threads >= 0,
+                "tsdf.threads must be >= 0 (0: one per core but one), got " << threads);
 }
 
 TsdfVolume::TsdfVolume(TsdfOptions options)
