@@ -110,7 +110,8 @@ struct TsdfVolume::IntegrationView {
   Eigen::Vector3f translation;
   Eigen::Matrix3f cam_rotation;
   Eigen::Vector3f cam_translation;
-  float half = 0, voxel = 0, band = 0;
+  // The truncation band, mm.
+  float band = 0;
   // Half-voxel samples along a ray across the band.
   int samples = 0;
   bool color = false;
@@ -132,10 +133,8 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   view.translation = volume_from_cam.translation().cast<float>();
   view.cam_rotation = cam_from_volume.rotation().cast<float>();
   view.cam_translation = cam_from_volume.translation().cast<float>();
-  view.half = static_cast<float>(0.5 * options_.size_mm);
-  view.voxel = static_cast<float>(voxel_mm_);
   view.band = static_cast<float>(truncation_mm_);
-  view.samples = static_cast<int>(std::floor(2.0f * view.band / (0.5f * view.voxel))) + 1;
+  view.samples = static_cast<int>(std::floor(2.0f * view.band / (0.5f * voxel_mm_float_))) + 1;
   view.color = options_.color && frame.HasColor();
 
   // The voxels within the band of the observed pixels, each thread marking those of every
@@ -206,8 +205,8 @@ void TsdfVolume::MarkBand(const IntegrationView& view, int v_first, int v_step, 
       // Half-voxel steps along the ray, in voxel units of the volume's grid.
       const Eigen::Vector3f step = view.rotation * ray * 0.5f;
       Eigen::Vector3f grid =
-          ((view.rotation * (point - view.band * ray) + view.translation).array() + view.half) /
-          view.voxel;
+          ((view.rotation * (point - view.band * ray) + view.translation).array() + half_mm_) /
+          voxel_mm_float_;
       for (int s = 0; s < view.samples; ++s, grid += step) {
         // Inside the cube the coordinates are non-negative: truncation is their floor.
         if (!(grid.x() >= 0 && grid.y() >= 0 && grid.z() >= 0)) continue;
@@ -354,7 +353,8 @@ struct TsdfVolume::RaycastView {
   Eigen::Matrix3f rotation;
   Eigen::Vector3f origin;
   Eigen::Matrix3f to_cam;
-  float half = 0, voxel = 0, band = 0, window = 0;
+  // The truncation band and the window around the observed depth, mm.
+  float band = 0, window = 0;
   // The observed box, and the pixels cast (exclusive ends).
   Eigen::Vector3f box_lo, box_hi;
   int u0 = 0, v0 = 0, u1 = 0, v1 = 0;
@@ -396,8 +396,6 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
   view.rotation = volume_from_cam.rotation().cast<float>();
   view.origin = volume_from_cam.translation().cast<float>();
   view.to_cam = cam_from_volume.rotation().cast<float>();
-  view.half = static_cast<float>(0.5 * options_.size_mm);
-  view.voxel = static_cast<float>(voxel_mm_);
   view.band = static_cast<float>(truncation_mm_);
   view.window = window_mm;
   view.box_lo = observed.min(), view.box_hi = observed.max();
@@ -425,7 +423,7 @@ void TsdfVolume::CastRows(const RaycastView& view, int v_first, int v_step,
   const CameraIntrinsics& intrinsics = view.intrinsics;
   const Eigen::Matrix3f& rotation = view.rotation;
   const Eigen::Vector3f& origin = view.origin;
-  const float voxel = view.voxel, band = view.band, half = view.half;
+  const float voxel = voxel_mm_float_, band = view.band, half = half_mm_;
   for (int v = v_first; v < view.v1; v += v_step) {
     for (int u = view.u0; u < view.u1; ++u) {
       const std::uint16_t near =
@@ -491,7 +489,7 @@ void TsdfVolume::NormalRows(const RaycastView& view, int v_first, int v_step,
   RaycastImage& image = *out;
   const CameraIntrinsics& intrinsics = view.intrinsics;
   const int u0 = view.u0, v0 = view.v0, u1 = view.u1, v1 = view.v1;
-  const float voxel = view.voxel, band = view.band;
+  const float voxel = voxel_mm_float_, band = view.band;
   auto surface_point = [&](int u, int v) -> Eigen::Vector3f {
     return intrinsics.BackProject(u, v, image.depth_mm[static_cast<size_t>(v) * image.width + u])
         .cast<float>();
