@@ -232,8 +232,7 @@ void AddLoopClosureOptions(OptionRegistry& r, fusion::LoopClosureOptions* option
   r.Add("fusion.loop_closure.loop_pending_keyframes", &l.loop_pending_keyframes,
         "... another of the same keyframe or of the next this many");
   r.Add("fusion.loop_closure.icp_start_mm", &l.icp_start_mm,
-        "a loop's ICP pairs points this far apart at first, then half as far pass by pass, mm");
-  r.Add("fusion.loop_closure.icp_end_mm", &l.icp_end_mm, "... down to this in its last pass, mm");
+        "a loop's ICP pairs points this far apart at first, then half, then a quarter, mm");
   r.Add("fusion.loop_closure.min_inlier_fraction", &l.min_inlier_fraction,
         "a loop pairs at least this share of the new keyframe's points");
   r.Add("fusion.loop_closure.max_rms_mm", &l.max_rms_mm, "... at this RMS at most, mm");

@@ -61,8 +61,7 @@ void LoopClosureOptions::Check() const {
   IHS_CHECK_ARG(loop_agreement_mm > 0, "fusion.loop_closure.loop_agreement_mm must be positive");
   IHS_CHECK_ARG(chain_trusted_kept > 0.5 && chain_trusted_kept <= 1,
                 "fusion.loop_closure.chain_trusted_kept must be in (0.5, 1]");
-  IHS_CHECK_ARG(icp_end_mm > 0 && icp_end_mm <= icp_start_mm,
-                "fusion.loop_closure.icp_end_mm must be positive and at most icp_start_mm");
+  IHS_CHECK_ARG(icp_start_mm > 0, "fusion.loop_closure.icp_start_mm must be positive");
   IHS_CHECK_ARG(min_inlier_fraction > 0 && min_inlier_fraction <= 1,
                 "fusion.loop_closure.min_inlier_fraction must be in (0, 1]");
   IHS_CHECK_ARG(max_rms_mm > 0 && max_correction_mm > 0 && refuse_min_mm >= 0,
@@ -458,14 +457,12 @@ std::optional<Rigid3> KeyframeGraph::Align(const Keyframe& from, const Rigid3& s
   IcpOptions options = icp_;
   IcpResult result;
   std::vector<Eigen::Vector3f> moved(from.points.size());
-  // Passes pairing points up to icp_start_mm apart, then half as far, down to icp_end_mm.
-  for (double distance = options_.icp_start_mm;; distance /= 2) {
-    options.max_distance_mm = std::max(options_.icp_end_mm, distance);
+  for (int pass = 0; pass < 3; ++pass) {
+    options.max_distance_mm = options_.icp_start_mm / (1 << pass);
     for (size_t i = 0; i < from.points.size(); ++i) moved[i] = motion * from.points[i];
     result = AlignToModel(moved, scratch_, intrinsics_, Rigid3(), options);
     if (!result.ok) return std::nullopt;
     motion = result.cam_from_volume.Inverse() * motion;
-    if (options.max_distance_mm <= options_.icp_end_mm) break;
   }
   const double min_fraction =
       free_allowed ? options_.feature_min_inlier_fraction : options_.min_inlier_fraction;

@@ -57,11 +57,9 @@ struct LoopClosureOptions {
   double loop_agreement_mm = 3.0;
   int loop_pending_keyframes = 4;
   /// The registration of a loop: ICP between the two keyframes' object points, pairs at most
-  /// `icp_start_mm` apart at first, then half as far pass by pass down to `icp_end_mm` (the
-  /// drift of a turn is more than the 5 mm of frame-to-frame ICP). 40: a cube turn that
-  /// drifted 32 mm under the hand closed no loop from 20 (docs/fusion.md, 2026-12-01).
-  double icp_start_mm = 40.0;
-  double icp_end_mm = 5.0;
+  /// this far apart at first (mm), halved twice (the drift of a turn is more than the 5 mm
+  /// of frame-to-frame ICP).
+  double icp_start_mm = 20.0;
   /// It is a loop when at least this share of the new keyframe's points pair within the last
   /// pass's distance, at this RMS at most (mm), and it moves the estimate by less than
   /// `max_correction_mm` (at the graph's lever).
