@@ -84,6 +84,7 @@ void ScanRecord::Add(const FramePacket& packet) {
     timing("pairwise_ms", fused.pairwise_ms);
     timing("raycast_ms", fused.raycast_ms);
     timing("icp_ms", fused.icp_ms);
+    timing("colour_ms", fused.colour_ms);
     timing("integrate_ms", fused.integrate_ms);
     entry["coverage"] = fused.coverage;
     coverage_ = fused.coverage;
@@ -106,6 +107,16 @@ void ScanRecord::Add(const FramePacket& packet) {
     if (fused.hand_caught_up_deg > 0) {
       entry["hand_caught_up_deg"] = fused.hand_caught_up_deg;
       hand_caught_up_deg_ += fused.hand_caught_up_deg;
+    }
+    if (fused.colour.shading_share > 0) {
+      entry["colour_shading_share"] = fused.colour.shading_share;
+      entry["colour_pattern_spread"] = fused.colour.pattern_spread;
+    }
+    if (fused.colour.applied) {
+      entry["colour_moved_mm"] = fused.colour.moved_mm;
+      entry["colour_turn_deg"] = fused.colour.turn_deg;
+      entry["colour_uncertainty_mm"] = fused.colour.uncertainty_mm;
+      ++colour_frames_;
     }
     if (fused.hand_carried_deg > 0) {
       entry["hand_carried_deg"] = fused.hand_carried_deg;
@@ -184,6 +195,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"feature_loops", feature_loops_},
                             {"keypoint_alias_deg", keypoint_alias_deg_},
                             {"loop_corrections", loop_corrections_},
+                            {"colour_aligned_frames", colour_frames_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},
                             {"hand_undecided_frames", hand_undecided_frames_},

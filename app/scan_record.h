@@ -81,6 +81,8 @@ class ScanRecord {
   // The last FusionResult::keypoint_alias_deg (0: none).
   double keypoint_alias_deg_ = 0;
   std::int64_t loop_corrections_ = 0;
+  // Frames the colour alignment moved (colour_align.h).
+  std::int64_t colour_frames_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;
   std::int64_t hand_back_frames_ = 0;

@@ -172,6 +172,9 @@ void AddTsdfOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
         "signed distances truncated to this many voxels");
   r.Add("fusion.tsdf.max_weight", &u.tsdf.max_weight, "cap of a voxel's integration weight");
   r.Add("fusion.tsdf.color", &u.tsdf.color, "voxels keep a colour");
+  r.Add("fusion.tsdf.color_band_voxels", &u.tsdf.color_band_voxels,
+        "voxels within this many voxels of the surface (along the ray) take a pixel's colour "
+        "(0: the whole truncation band)");
   r.Add("fusion.tsdf.threads", &u.tsdf.threads,
         "threads that integrate and raycast (0: one per core but the tracker thread's; at most "
         "8); the model is the same whatever the number");
@@ -416,6 +419,43 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
   r.Add("fusion.icp_contacts_need_spread", &u.icp_contacts_need_spread,
         "contacts hold ICP only when spread like pairwise.min_contact_spread_mm asks (off: one "
         "fingertip's patch holds it too, in the directions the surface leaves free)");
+  r.Add("fusion.colour.enabled", &u.colour.enabled,
+        "after ICP, the object's colours are aligned to the model's in the directions its "
+        "surface leaves free (a patterned ball's or bottle's turn)");
+  r.Add("fusion.colour.shading_blur_px", &u.colour.shading_blur_px,
+        "the colour alignment compares the log grey less its blur by this, pixels (0: the grey)");
+  r.Add("fusion.colour.remove_shading", &u.colour.remove_shading,
+        "the colour alignment takes out of both images what the surface's normals explain");
+  r.Add("fusion.colour.max_shading_share", &u.colour.max_shading_share,
+        "where the normals explain more of the frame's detail, the colour alignment does not run");
+  r.Add("fusion.colour.coarse_blur_px", &u.colour.coarse_blur_px,
+        "the colour alignment's first blur of both grey images, pixels");
+  r.Add("fusion.colour.fine_blur_px", &u.colour.fine_blur_px,
+        "the colour alignment's second blur, pixels");
+  r.Add("fusion.colour.iterations", &u.colour.iterations,
+        "the colour alignment's Gauss-Newton iterations per blur");
+  r.Add("fusion.colour.stride", &u.colour.stride,
+        "the colour alignment uses every n-th object pixel each way");
+  r.Add("fusion.colour.max_points", &u.colour.max_points,
+        "the colour alignment uses at most about this many object pixels (a wider stride)");
+  r.Add("fusion.colour.prior_mm", &u.colour.prior_mm,
+        "the colour alignment's prior on its motion away from ICP's pose, mm RMS");
+  r.Add("fusion.colour.max_depth_gap_mm", &u.colour.max_depth_gap_mm,
+        "a pixel's colour is compared with the model's only where their depths differ less, mm");
+  r.Add("fusion.colour.min_facing", &u.colour.min_facing,
+        "the colour alignment leaves out model surface facing the camera less (cosine)");
+  r.Add("fusion.colour.profile_mm", &u.colour.profile_mm,
+        "the colour alignment judges its basin by the cost this far either way, mm");
+  r.Add("fusion.colour.correlated_samples", &u.colour.correlated_samples,
+        "object pixels whose colour residuals one blur footprint correlates");
+  r.Add("fusion.colour.min_model_colourings", &u.colour.min_model_colourings,
+        "the colour alignment compares the model's colour only where this many pixels coloured "
+        "it");
+  r.Add("fusion.colour.min_points", &u.colour.min_points,
+        "object pixels the colour alignment needs");
+  r.Add("fusion.colour.min_grey_spread", &u.colour.min_grey_spread,
+        "the least spread of the frame's detail after the shading (100 x log grey) that the "
+        "colour alignment takes for a pattern");
   r.Add("fusion.model_contacts.enabled", &u.model_contacts.enabled,
         "fingertips on the model's surface in the previous frame are contacts too");
   r.Add("fusion.model_contacts.distance_mm", &u.model_contacts.distance_mm,

@@ -94,6 +94,8 @@ class Aligner {
   int iterations() const { return iterations_; }
   int free_directions() const { return free_directions_; }
   const Eigen::Vector3d& pivot() const { return pivot_; }
+  const std::vector<FreeDirection>& free() const { return free_; }
+  const Eigen::Vector3d& free_centre() const { return free_centre_; }
 
  private:
   // One iteration; returns whether another may follow.
@@ -117,6 +119,11 @@ class Aligner {
   Vector6 Solve(Equations surface, const Equations& anchored);
   // The step in the directions the surface constrains, the anchors' in the others.
   Vector6 SolveConstrained(const Equations& surface, const Equations& anchored);
+  // Lists the directions the surface leaves free (free_), where its constraint (an eigenvalue
+  // of `surface` per pair) is within min_constraint_over_noise of the normals' noise; returns
+  // the eigen decomposition and the free directions' indices into it.
+  std::vector<int> JudgeFree(const Equations& surface,
+                             Eigen::SelfAdjointEigenSolver<Matrix6>* eigen = nullptr);
   // Applies `step` (a twist about the centre) to the correction.
   void ApplyStep(const Vector6& step);
 
@@ -152,6 +159,9 @@ class Aligner {
   int free_directions_ = -1;
   // What a direction of the motion learns per point pair from the model's normal noise alone.
   double noise_information_ = 0;
+  // The free directions of the last iteration that judged them, and the centre they turn about.
+  std::vector<FreeDirection> free_;
+  Eigen::Vector3d free_centre_ = Eigen::Vector3d::Zero();
 };
 
 Aligner::Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
@@ -190,8 +200,11 @@ void Aligner::Run() {
 bool Aligner::Iterate(int iteration) {
   centre_ = correction_ * pivot_;
   const bool find_pivot = keep_free_ && iteration == 0;
+  // Where the anchors join every direction, the free ones are still judged, aside (reported,
+  // not used).
+  const bool judge_aside = !keep_free_ && options_.min_constraint_over_noise > 0;
   NormalLines lines;
-  Equations surface = PairPoints(find_pivot ? &lines : nullptr);
+  Equations surface = PairPoints(find_pivot || (judge_aside && iteration == 0) ? &lines : nullptr);
   if (iteration == 0) first_inliers_ = inliers_;
   if (inliers_ > best_inliers_) {
     best_inliers_ = inliers_, best_correction_ = correction_, best_rms_ = rms_;
@@ -200,7 +213,9 @@ bool Aligner::Iterate(int iteration) {
     MovePivot(lines, &surface);
     MeasureNormalNoise(&lines.jitter);
   }
+  if (judge_aside && iteration == 0) MeasureNormalNoise(&lines.jitter);
   const Equations anchored = AnchorEquations();
+  if (judge_aside && noise_information_ > 0) JudgeFree(surface);
   if (!keep_free_) {
     surface.matrix += anchored.matrix;
     surface.rhs += anchored.rhs;
@@ -343,23 +358,37 @@ Vector6 Aligner::Solve(Equations surface, const Equations& anchored) {
 Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anchored) {
   // Only the directions the surface constrains move; the others keep the prediction, or
   // follow the anchors where they have any.
-  const Eigen::SelfAdjointEigenSolver<Matrix6> eigen(surface.matrix);
-  const double floor = options_.min_constraint_over_noise * noise_information_ * inliers_;
+  Eigen::SelfAdjointEigenSolver<Matrix6> eigen;
+  const std::vector<int> free = JudgeFree(surface, &eigen);
   Vector6 step = Vector6::Zero();
-  std::vector<int> free;
   for (int i = 0; i < 6; ++i) {
-    const double value = eigen.eigenvalues()[i];
-    if (value <= floor || value <= 0) {
-      free.push_back(i);
-      continue;
-    }
+    if (std::find(free.begin(), free.end(), i) != free.end()) continue;
     const auto direction = eigen.eigenvectors().col(i);
-    step += direction * (direction.dot(surface.rhs) / value);
+    step += direction * (direction.dot(surface.rhs) / eigen.eigenvalues()[i]);
   }
   free_directions_ = static_cast<int>(free.size());
   if (!free.empty() && !anchors_.empty())
     step += AnchorStep(eigen.eigenvectors(), free, anchored.matrix, anchored.rhs, step);
   return step;
+}
+
+std::vector<int> Aligner::JudgeFree(const Equations& surface,
+                                    Eigen::SelfAdjointEigenSolver<Matrix6>* eigen) {
+  Eigen::SelfAdjointEigenSolver<Matrix6> own;
+  if (!eigen) eigen = &own;
+  eigen->compute(surface.matrix);
+  const double floor = options_.min_constraint_over_noise * noise_information_ * inliers_;
+  std::vector<int> free;
+  free_.clear();
+  free_centre_ = centre_;
+  for (int i = 0; i < 6; ++i) {
+    const double value = eigen->eigenvalues()[i];
+    if (!(value <= floor || value <= 0)) continue;
+    free.push_back(i);
+    const auto direction = eigen->eigenvectors().col(i);
+    free_.push_back({direction.head<3>() / scale_, direction.tail<3>()});
+  }
+  return free;
 }
 
 void Aligner::ApplyStep(const Vector6& step) {
@@ -402,6 +431,8 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   result.rms_mm = aligner.rms();
   result.free_directions = aligner.free_directions();
   result.pivot = aligner.pivot();
+  result.free = aligner.free();
+  result.free_centre = aligner.free_centre();
   // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.
   result.cam_from_volume = aligner.correction().Inverse() * predicted;
   CheckEnoughPairs(needed, points.size(), &result);

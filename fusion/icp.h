@@ -14,6 +14,13 @@
 
 namespace ihs::fusion {
 
+/// A direction of an object's motion: the turn (radians per unit, about a centre given with
+/// it) and the shift (mm per unit) it makes.
+struct FreeDirection {
+  Eigen::Vector3d turn = Eigen::Vector3d::Zero();
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+};
+
 /// Options of the ICP refinement (defaults: the paper's 5 mm correspondences).
 struct IcpOptions {
   /// Gauss–Newton iterations at most; it stops earlier once a step moves less than 0.01 mm.
@@ -86,6 +93,11 @@ struct IcpResult {
   /// (a ball's centre, a point on a bottle's axis) where the free directions were judged, else
   /// the points' centroid.
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  /// The free directions of the last iteration as motions of the predicted camera's points
+  /// (where the model's raycast is): a point q moves by turn × (q − free_centre) + shift per unit
+  /// (turn in radians, shift in mm; unit vectors of ICP's scaled twist). Empty where none.
+  std::vector<FreeDirection> free;
+  Eigen::Vector3d free_centre = Eigen::Vector3d::Zero();
 };
 
 /// A point of the current frame (camera frame, mm) that must land at `target`, where the

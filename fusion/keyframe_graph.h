@@ -85,8 +85,12 @@ struct LoopClosureOptions {
   /// and no motion turned more than `feature_distinct_deg` from it has more than
   /// `feature_max_rival` of their number (a pattern that repeats round the object, as a
   /// checkerboard does every 60°, lets two motions explain the matches). Such loops are
-  /// confirmed by a second one as every loop is.
-  bool feature_loops = true;
+  /// confirmed by a second one as every loop is. Off by default since the colour alignment
+  /// (colour_align.h) registers every frame of a patterned object against the model: on 29
+  /// patterned and labelled lathe and ball turns the keypoint loops then closed few loops,
+  /// some of them wrong (a labelled pin's mesh.ply 0.29 -> 3.28 mm), and with them off the end
+  /// error was 9.8 -> 8.5° (docs/fusion.md, "The colour where the shape leaves the turn free").
+  bool feature_loops = false;
   int feature_keypoints = 150;
   double feature_max_turn_deg = 90.0;
   int feature_tries = 4;

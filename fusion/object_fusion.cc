@@ -32,6 +32,7 @@ void FusionOptions::Check() const {
   turn_carry.Check();
   free_space.Check();
   loop_closure.Check();
+  colour.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -389,6 +390,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   result->contact_noise_mm = contact_noise_mm_;
   result->icp_anchors = static_cast<int>(anchors.size());
   result->icp = AlignAt(object, setup, *pose, anchors, result);
+  Rigid3 icp_predicted = *pose;
   // A registration that lands far off (a bad contact, a slipped finger) leaves ICP few pairs;
   // from where the object was, it may find more.
   const double paired = static_cast<double>(result->icp.inliers) / object.points.size();
@@ -396,6 +398,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     IcpResult retry = AlignAt(object, setup, cam_from_object_, {}, result);
     if (retry.ok && retry.inliers > 1.2 * result->icp.inliers) {
       result->icp = std::move(retry);
+      icp_predicted = cam_from_object_;
       result->icp_from_previous = true;
     }
   }
@@ -403,6 +406,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     surface_left_free_ = result->icp.free_directions != 0;
     turn_carry_.ObserveSurface(result->icp.free_directions);
     *pose = result->icp.cam_from_volume;
+    AlignColours(object, icp_predicted, pose, result);
     return true;
   }
   return result->pairwise.ok;
@@ -473,12 +477,34 @@ IcpResult ObjectFusion::AlignAt(const ObjectPixels& object, const IcpSetup& setu
                                 FusionResult* result) {
   const auto raycast_start = SteadyClock::now();
   volume_.Raycast(intrinsics_, predicted, setup.roi, &near_depth_, setup.window, &model_image_);
+  model_image_pose_ = predicted;
   result->raycast_ms += MillisecondsSince(raycast_start);
   const auto icp_start = SteadyClock::now();
   IcpResult icp =
       AlignToModel(object.points, model_image_, intrinsics_, predicted, setup.options, anchors);
   result->icp_ms += MillisecondsSince(icp_start);
   return icp;
+}
+
+void ObjectFusion::AlignColours(const ObjectPixels& object, const Rigid3& icp_predicted,
+                                Rigid3* pose, FusionResult* result) const {
+  if (!options_.colour.enabled || result->icp.free.empty()) return;
+  const auto start = SteadyClock::now();
+  // ICP's correction takes the frame's points to where model_image_ sees them.
+  const Rigid3 correction = model_image_pose_ * pose->Inverse();
+  // The free directions are in the camera frame of ICP's prediction; model_image_ may have been
+  // cast from another (a retry from the previous pose that was not kept).
+  const Rigid3 to_image = model_image_pose_ * icp_predicted.Inverse();
+  std::vector<FreeDirection> free = result->icp.free;
+  for (FreeDirection& direction : free) {
+    direction.turn = to_image.rotation() * direction.turn;
+    direction.shift = to_image.rotation() * direction.shift;
+  }
+  result->colour =
+      AlignColour(object.frame, object.mask, object.box, model_image_, intrinsics_, correction,
+                  free, to_image * result->icp.free_centre, options_.colour);
+  if (result->colour.applied) *pose = result->colour.correction.Inverse() * model_image_pose_;
+  result->colour_ms = MillisecondsSince(start);
 }
 
 std::string ObjectFusion::ImplausibleJump(const Rigid3& pose, const Rigid3& step) const {

@@ -17,6 +17,7 @@
 #include "core/rigid3.h"
 #include "core/stopwatch.h"
 #include "core/triangle_mesh.h"
+#include "fusion/colour_align.h"
 #include "fusion/free_space.h"
 #include "fusion/icp.h"
 #include "fusion/keyframe_graph.h"
@@ -45,6 +46,9 @@ struct FusionOptions {
   TurnCarryOptions turn_carry;
   /// Keyframes, loops after a turn and the drift they correct (keyframe_graph.h).
   LoopClosureOptions loop_closure;
+  /// After ICP, the frame's colours against the model's in the directions the surface leaves
+  /// free (colour_align.h).
+  ColourAlignOptions colour;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -169,6 +173,8 @@ struct FusionResult {
   /// How the pose was found.
   PairwiseResult pairwise;
   IcpResult icp;
+  /// The colour alignment after ICP (colour_align.h; not run: reason says why).
+  ColourAlignResult colour;
   int integrated_voxels = 0;
   /// The share of directions around the object the registered frames so far have seen it
   /// from (view_coverage.h), this frame included when registered: how complete the model is.
@@ -222,6 +228,7 @@ struct FusionResult {
   double pairwise_ms = 0;
   double raycast_ms = 0;
   double icp_ms = 0;
+  double colour_ms = 0;
   double integrate_ms = 0;
 };
 
@@ -306,6 +313,10 @@ class ObjectFusion {
   // Raycasts the model at `predicted` and aligns the object's points to it (timed in `result`).
   IcpResult AlignAt(const ObjectPixels& object, const IcpSetup& setup, const Rigid3& predicted,
                     const std::vector<IcpAnchor>& anchors, FusionResult* result);
+  // Moves `pose` (ICP's from `icp_predicted`) along the free directions ICP found so that the
+  // object's colours land on the model's (model_image_; FusionOptions::colour).
+  void AlignColours(const ObjectPixels& object, const Rigid3& icp_predicted, Rigid3* pose,
+                    FusionResult* result) const;
   // Why the step from the previous pose to `pose` is implausible (empty when it is not).
   std::string ImplausibleJump(const Rigid3& pose, const Rigid3& step) const;
   // Updates the running estimate of the contacts' noise from how far `step` leaves them.
@@ -345,6 +356,8 @@ class ObjectFusion {
   FreeSpace free_space_;
   // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
   RaycastImage model_image_;
+  // Where model_image_ was raycast from (cam_from_object).
+  Rigid3 model_image_pose_;
   std::vector<std::uint16_t> near_depth_;
   bool started_ = false;
   Rigid3 cam_from_object_;

@@ -33,6 +33,9 @@ void TsdfOptions::Check() const {
                 "tsdf.max_weight must be in [1, 65535], got " << max_weight);
   IHS_CHECK_ARG(threads >= 0,
                 "tsdf.threads must be >= 0 (0: one per core but one), got " << threads);
+  IHS_CHECK_ARG(
+      color_band_voxels >= 0,
+      "tsdf.color_band_voxels must be >= 0 (0: the whole band), got " << color_band_voxels);
 }
 
 TsdfVolume::TsdfVolume(TsdfOptions options)
@@ -115,6 +118,8 @@ struct TsdfVolume::IntegrationView {
   // Half-voxel samples along a ray across the band.
   int samples = 0;
   bool color = false;
+  // Voxels this near the surface (mm, along the ray) take a pixel's colour.
+  float color_band = 0;
   bool Observed(int pixel) const {
     return frame.depth_mm[pixel] != 0 && (mask.empty() || mask[pixel] != 0);
   }
@@ -136,6 +141,9 @@ int TsdfVolume::Integrate(const Frame& frame, const std::vector<std::uint8_t>& m
   view.band = static_cast<float>(truncation_mm_);
   view.samples = static_cast<int>(std::floor(2.0f * view.band / (0.5f * voxel_mm_float_))) + 1;
   view.color = options_.color && frame.HasColor();
+  view.color_band = options_.color_band_voxels > 0
+                        ? static_cast<float>(options_.color_band_voxels) * voxel_mm_float_
+                        : view.band;
 
   // The voxels within the band of the observed pixels, each thread marking those of every
   // threads-th row in bits of its own, then gathered in memory order (each voxel once).
@@ -255,12 +263,15 @@ int TsdfVolume::UpdateWords(const IntegrationView& view, const std::int64_t* wor
     const float weight = voxel_ref.weight;
     const float mean = (voxel_ref.tsdf / kTsdfScale * weight + tsdf) / (weight + 1);
     voxel_ref.tsdf = static_cast<std::int16_t>(RoundToInt(mean * kTsdfScale));
-    if (view.color && std::abs(distance) < band) {
+    if (view.color && std::abs(distance) < view.color_band) {
+      const float seen = voxel_ref.color_weight;
       for (int c = 0; c < 3; ++c) {
         const float value = frame.rgb[3 * pixel + c];
-        voxel_ref.rgb[c] = static_cast<std::uint8_t>(
-            RoundToInt((voxel_ref.rgb[c] * weight + value) / (weight + 1)));
+        voxel_ref.rgb[c] =
+            static_cast<std::uint8_t>(RoundToInt((voxel_ref.rgb[c] * seen + value) / (seen + 1)));
       }
+      voxel_ref.color_weight = static_cast<std::uint8_t>(
+          std::min<int>(std::min(255, options_.max_weight), voxel_ref.color_weight + 1));
     }
     voxel_ref.weight =
         static_cast<std::uint16_t>(std::min<int>(options_.max_weight, voxel_ref.weight + 1));
@@ -368,12 +379,13 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
   const size_t pixels = static_cast<size_t>(intrinsics.width) * intrinsics.height;
   if (image.width != intrinsics.width || image.height != intrinsics.height ||
       image.depth_mm.size() != pixels || image.normals.size() != pixels ||
-      image.colors.size() != pixels) {
+      image.colors.size() != pixels || image.color_weights.size() != pixels) {
     image.width = intrinsics.width;
     image.height = intrinsics.height;
     image.depth_mm.assign(pixels, 0.0f);
     image.normals.assign(pixels, Eigen::Vector3f::Zero());
     image.colors.assign(pixels, {0, 0, 0});
+    image.color_weights.assign(pixels, 0);
   } else {
     const auto [x0, y0, x1, y1] = image.written;
     for (int v = std::max(0, y0); v < std::min(image.height, y1); ++v) {
@@ -382,6 +394,7 @@ void TsdfVolume::Raycast(const CameraIntrinsics& intrinsics, const Rigid3& cam_f
         image.depth_mm[p] = 0;
         image.normals[p] = Eigen::Vector3f::Zero();
         image.colors[p] = {0, 0, 0};
+        image.color_weights[p] = 0;
       }
     }
   }
@@ -465,12 +478,7 @@ void TsdfVolume::CastRows(const RaycastView& view, int v_first, int v_step,
           const Eigen::Vector3f point = origin + hit * ray;
           const size_t pixel = static_cast<size_t>(v) * image.width + u;
           image.depth_mm[pixel] = (hit * ray_cam.normalized()).z();
-          const Eigen::Vector3f grid = (point.array() + half) / voxel;
-          const int i = std::clamp(static_cast<int>(grid.x()), 0, n_ - 1);
-          const int j = std::clamp(static_cast<int>(grid.y()), 0, n_ - 1);
-          const int k = std::clamp(static_cast<int>(grid.z()), 0, n_ - 1);
-          const Voxel& nearest = voxels_[Index(i, j, k)];
-          image.colors[pixel] = {nearest.rgb[0], nearest.rgb[1], nearest.rgb[2]};
+          image.colors[pixel] = ColorAt(point, half, voxel, &image.color_weights[pixel]);
           break;
         }
         previous_t = t, previous = distance, has_previous = true;
@@ -536,6 +544,32 @@ void TsdfVolume::NormalRows(const RaycastView& view, int v_first, int v_step,
   }
 }
 
+TriangleMesh::Color TsdfVolume::ColorAt(const Eigen::Vector3f& point, float half, float voxel,
+                                        std::uint8_t* weight) const {
+  // Trilinear over the cell's corners that have a colour.
+  const Eigen::Vector3f grid = (point.array() + half) / voxel - 0.5f;
+  const int i = std::clamp(static_cast<int>(std::floor(grid.x())), 0, n_ - 2);
+  const int j = std::clamp(static_cast<int>(std::floor(grid.y())), 0, n_ - 2);
+  const int k = std::clamp(static_cast<int>(std::floor(grid.z())), 0, n_ - 2);
+  const Eigen::Vector3f f = (grid - Eigen::Vector3f(i, j, k)).cwiseMax(0.0f).cwiseMin(1.0f);
+  float sum[3] = {0, 0, 0}, total = 0, seen = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+    const Voxel& v = voxels_[Index(i + dx, j + dy, k + dz)];
+    if (v.color_weight == 0) continue;
+    const float w = (dx ? f.x() : 1 - f.x()) * (dy ? f.y() : 1 - f.y()) * (dz ? f.z() : 1 - f.z());
+    for (int c = 0; c < 3; ++c) sum[c] += w * v.rgb[c];
+    total += w;
+    seen += w * v.color_weight;
+  }
+  *weight = 0;
+  if (!(total > 0)) return {0, 0, 0};
+  *weight = static_cast<std::uint8_t>(std::lround(seen / total));
+  TriangleMesh::Color rgb;
+  for (int c = 0; c < 3; ++c) rgb[c] = static_cast<std::uint8_t>(std::lround(sum[c] / total));
+  return rgb;
+}
+
 TriangleMesh TsdfVolume::ExtractMesh() const {
   TriangleMesh mesh;
   const bool color = options_.color;
@@ -551,9 +585,11 @@ TriangleMesh TsdfVolume::ExtractMesh() const {
     if (color) {
       const Voxel& va = voxels_[Index(a[0], a[1], a[2])];
       const Voxel& vb = voxels_[Index(b[0], b[1], b[2])];
+      // Between the two where both have a colour, else the one that has.
+      const float t = va.color_weight == 0 ? 1.0f : vb.color_weight == 0 ? 0.0f : s;
       TriangleMesh::Color rgb;
       for (int c = 0; c < 3; ++c) {
-        rgb[c] = static_cast<std::uint8_t>(std::lround(va.rgb[c] + s * (vb.rgb[c] - va.rgb[c])));
+        rgb[c] = static_cast<std::uint8_t>(std::lround(va.rgb[c] + t * (vb.rgb[c] - va.rgb[c])));
       }
       mesh.colors.push_back(rgb);
     }

@@ -32,6 +32,13 @@ struct TsdfOptions {
   int max_weight = 128;
   /// Whether voxels keep a colour (the weighted mean of the pixels that saw them).
   bool color = true;
+  /// A voxel takes a pixel's colour only within this many voxels of the surface seen through
+  /// the pixel (along the ray; 0: anywhere in the truncation band): the pixels that colour a
+  /// voxel are then those that saw its surface (a voxel off the surface takes the colour of the
+  /// point where the pixel's ray meets it), and their count (Voxel::color_weight) says how
+  /// often the model's colour there was seen (ColourAlignOptions::min_model_colourings).
+  /// Raycasts and meshes interpolate the colour between the voxels that have one.
+  double color_band_voxels = 1.0;
   /// Threads that integrate and raycast, the calling one among them (at most kMaxThreads).
   /// 0: one per core but one, which the pipeline's tracker thread keeps busy (on two cores the
   /// calling thread alone). Each voxel and each pixel is computed by one thread as it would be
@@ -55,6 +62,8 @@ struct RaycastImage {
   std::vector<float> depth_mm;
   std::vector<Eigen::Vector3f> normals;
   std::vector<TriangleMesh::Color> colors;
+  /// How many pixels coloured the model there (0: none; at most 255).
+  std::vector<std::uint8_t> color_weights;
   /// The pixels a raycast may have written (u0, v0, u1, v1; exclusive ends): everything
   /// outside is zero.
   std::array<int, 4> written = {0, 0, 0, 0};
@@ -109,11 +118,15 @@ class TsdfVolume {
   Eigen::AlignedBox3f ObservedBox() const;
 
  private:
+  // The colour at `point` (volume frame, mm) for a cube of edge 2·`half` and voxel `voxel`.
+  // and how many pixels coloured it there (the corners' weighted mean).
+  TriangleMesh::Color ColorAt(const Eigen::Vector3f& point, float half, float voxel,
+                              std::uint8_t* weight) const;
   struct Voxel {
     std::int16_t tsdf = 0;  // Signed distance / truncation, scaled to ±32767.
     std::uint16_t weight = 0;
     std::uint8_t rgb[3] = {0, 0, 0};
-    std::uint8_t unused = 0;
+    std::uint8_t color_weight = 0;  // Pixels that coloured it (at most 255).
   };
   // Voxels lie in bricks of 8³ (4 KiB, x fastest inside a brick, then y, then z; the bricks in
   // the same order): a voxel's neighbours along all three axes are mostly in its own brick, so

@@ -278,6 +278,19 @@ TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
     const Eigen::Vector3d q = direction.normalized() * radii.x();
     anchors.push_back({truth * q, predicted * q, 1.0});
   }
+  // Anchors in every direction (contacts spread across fingertips): the free directions are
+  // still judged, aside, for the colour alignment after ICP (colour_align.h).
+  const IcpResult joined = AlignToModel(points, volume.Raycast(intrinsics, predicted), intrinsics,
+                                        predicted, IcpOptions(), anchors);
+  EXPECT_EQ(joined.free_directions, -1) << "the anchors joined every direction";
+  EXPECT_EQ(joined.free.size(), 3u) << "a ball's three turns, judged aside";
+  for (const FreeDirection& free : joined.free) {
+    // A turn about the ball's centre moves no point of its surface off it.
+    const Eigen::Vector3d centre = predicted.translation();
+    const Eigen::Vector3d on = centre + Eigen::Vector3d(0, 0, -radii.x());
+    const Eigen::Vector3d moved = free.turn.cross(on - joined.free_centre) + free.shift;
+    EXPECT_LT(std::abs(moved.dot((on - centre).normalized())), 0.05 * moved.norm() + 1e-6);
+  }
   IcpOptions options;
   options.anchors_free_directions_only = true;
   const IcpResult result = AlignToModel(points, volume.Raycast(intrinsics, predicted), intrinsics,

@@ -1,0 +1,216 @@
+// The colour alignment after ICP: a ball's model fused with its colours from views all around;
+// a new view predicted turned about the ball's centre (a turn its surface leaves free, so ICP
+// keeps it). With a pattern on the ball, the colours find the turn; without one (a uniform,
+// shaded ball) nothing moves.
+
+#include "fusion/colour_align.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "fusion/object_fusion.h"
+#include "tests/frame_fixtures.h"
+
+namespace ihs::fusion {
+namespace {
+
+constexpr double kRadius = 40.0;
+
+// Paints the ball seen at `cam_from_object`: a printed pattern of the object frame's directions
+// (none with `patterned` false), shaded by a light at the camera, with a little noise.
+void Paint(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bool patterned,
+           std::mt19937& rng, Frame* frame) {
+  std::normal_distribution<double> noise(0.0, 2.0);
+  const Eigen::Vector3d centre = cam_from_object.translation();
+  for (int v = 0; v < frame->height; ++v) {
+    for (int u = 0; u < frame->width; ++u) {
+      const std::uint16_t depth = frame->DepthAt(u, v);
+      if (depth == 0) continue;
+      const Eigen::Vector3d p = intrinsics.BackProject(u, v, depth);
+      const Eigen::Vector3d normal = (p - centre).normalized();
+      const Eigen::Vector3d d = cam_from_object.rotation().transpose() * normal;
+      const double phi = std::atan2(d.x(), d.z()), theta = std::asin(std::clamp(d.y(), -1.0, 1.0));
+      // A print: dark patches on a light ground, nowhere alike.
+      double albedo = 0.7;
+      if (patterned) {
+        albedo =
+            std::sin(5 * phi + 1.3) * std::cos(4 * theta) + 0.5 * std::sin(3 * phi + 7 * theta) > 0
+                ? 0.9
+                : 0.25;
+      }
+      const double shade = 0.4 + 0.6 * std::max(0.0, -normal.dot(p.normalized()));
+      for (int c = 0; c < 3; ++c) {
+        const double value = 255 * albedo * shade *
+                                 (c == 0   ? 1.0
+                                  : c == 1 ? 0.8
+                                           : 0.6) +
+                             noise(rng);
+        frame->rgb[3 * (v * frame->width + u) + c] =
+            static_cast<std::uint8_t>(std::clamp(std::lround(value), 0L, 255L));
+      }
+    }
+  }
+}
+
+Frame Ball(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bool patterned,
+           std::mt19937& rng) {
+  Frame frame = test::RenderEllipsoid(intrinsics, cam_from_object,
+                                      Eigen::Vector3d(kRadius, kRadius, kRadius));
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (std::uint16_t& depth : frame.depth_mm) {
+    if (depth != 0) depth = static_cast<std::uint16_t>(std::lround(depth + noise(rng)));
+  }
+  Paint(intrinsics, cam_from_object, patterned, rng, &frame);
+  return frame;
+}
+
+double TurnDeg(const Rigid3& a, const Rigid3& b) {
+  return Eigen::AngleAxisd(a.rotation() * b.rotation().transpose()).angle() * 180 / M_PI;
+}
+
+struct Outcome {
+  double icp_off_deg = 0;     // ICP's pose against the truth
+  double colour_off_deg = 0;  // after the colour alignment
+  double centre_off_mm = 0;   // the colour alignment's centre against the truth
+  ColourAlignResult colour;
+};
+
+// The ball fused from views all around, then a view predicted `turn_deg` off about its centre
+// and 2 mm off (which the surface fixes).
+Outcome AlignTurnedBall(bool patterned, double turn_deg) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  std::mt19937 rng(11);
+  TsdfVolume volume;
+  // 80 views all around (5 tilts, 16 turns): each part of the surface coloured by several.
+  for (int tilt = -2; tilt <= 2; ++tilt) {
+    for (int turn = 0; turn < 16; ++turn) {
+      const Rigid3 view = Rigid3::Translation({0, 0, 500}) *
+                          Rigid3::FromAxisAngle({1, 0, 0}, 0.3 * tilt) *
+                          Rigid3::FromAxisAngle({0, 1, 0}, turn * M_PI / 8);
+      volume.Integrate(Ball(intrinsics, view, patterned, rng), {}, intrinsics, view);
+    }
+  }
+  const Rigid3 truth =
+      Rigid3::Translation({6, -4, 480}) * Rigid3::FromAxisAngle(Eigen::Vector3d(0.1, 1, 0.3), 0.7);
+  const Frame frame = Ball(intrinsics, truth, patterned, rng);
+  std::vector<std::uint8_t> mask(frame.depth_mm.size(), 0);
+  std::array<int, 4> box = {frame.width, frame.height, 0, 0};
+  std::vector<Eigen::Vector3f> points;
+  for (int v = 0; v < frame.height; ++v) {
+    for (int u = 0; u < frame.width; ++u) {
+      if (frame.DepthAt(u, v) == 0) continue;
+      mask[v * frame.width + u] = 1;
+      box = {std::min(box[0], u), std::min(box[1], v), std::max(box[2], u + 1),
+             std::max(box[3], v + 1)};
+      points.push_back(intrinsics.BackProject(u, v, frame.DepthAt(u, v)).cast<float>());
+    }
+  }
+  const Rigid3 predicted =
+      Rigid3::Translation({2, 0, 0}) * Rigid3::Translation(truth.translation()) *
+      Rigid3::FromAxisAngle(Eigen::Vector3d(0.3, 1, -0.2), turn_deg * M_PI / 180) *
+      Rigid3::Translation(-truth.translation()) * truth;
+  const RaycastImage model = volume.Raycast(intrinsics, predicted);
+  const IcpResult icp = AlignToModel(points, model, intrinsics, predicted);
+  EXPECT_TRUE(icp.ok) << icp.reason;
+  EXPECT_EQ(icp.free.size(), 3u) << "a ball's three turns";
+  Outcome out;
+  out.icp_off_deg = TurnDeg(icp.cam_from_volume, truth);
+  const Rigid3 correction = predicted * icp.cam_from_volume.Inverse();
+  // The model is fused from 80 views: a voxel was coloured by a few of them.
+  ColourAlignOptions options;
+  options.min_model_colourings = 2;
+  out.colour = AlignColour(frame, mask, box, model, intrinsics, correction, icp.free,
+                           icp.free_centre, options);
+  const Rigid3 pose = out.colour.correction.Inverse() * predicted;
+  out.colour_off_deg = TurnDeg(pose, truth);
+  out.centre_off_mm = (pose.translation() - truth.translation()).norm();
+  std::printf(
+      "%s ball, predicted %.1f° off: ICP %.2f° off, colour %.2f° off (%s; moved %.2f mm, "
+      "uncertainty %.3f mm, %d points, sigma %.1f, pattern %.1f, shading %.2f), centre %.2f mm "
+      "off\n",
+      patterned ? "patterned" : "uniform", turn_deg, out.icp_off_deg, out.colour_off_deg,
+      out.colour.applied ? "applied" : out.colour.reason.c_str(), out.colour.moved_mm,
+      out.colour.uncertainty_mm, out.colour.points, out.colour.sigma, out.colour.pattern_spread,
+      out.colour.shading_share, out.centre_off_mm);
+  return out;
+}
+
+TEST(ColourAlignTest, APatternedBallsFreeTurnIsFoundByItsColours) {
+  for (const double turn : {2.0, 5.0}) {
+    const Outcome out = AlignTurnedBall(/*patterned=*/true, turn);
+    EXPECT_GT(out.icp_off_deg, 0.6 * turn) << "ICP kept the free turn: the test needs it to";
+    EXPECT_TRUE(out.colour.applied) << out.colour.reason;
+    EXPECT_LT(out.colour_off_deg, std::min(1.0, 0.3 * out.icp_off_deg));
+    EXPECT_LT(out.centre_off_mm, 0.5) << "what the surface fixed stays fixed";
+    EXPECT_LT(out.colour.uncertainty_mm, 0.3);
+  }
+}
+
+TEST(ColourAlignTest, AUniformShadedBallIsNotTurned) {
+  const Outcome out = AlignTurnedBall(/*patterned=*/false, 5.0);
+  EXPECT_NEAR(out.colour_off_deg, out.icp_off_deg, 0.3) << "shading is no pattern";
+  EXPECT_LT(out.colour.moved_mm, 0.2);
+}
+
+// A patterned ball shown still for 10 frames (as a scan starts), then turned 2° a frame about
+// a tilted axis through its centre for 90 frames, with nothing but its depth and colours (no
+// features, no contacts): the end's turn error.
+constexpr int kStill = 10, kFrames = 100;
+
+double TurnedBallEndError(bool colour) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  std::mt19937 rng(5);
+  FusionOptions options;
+  options.colour.enabled = colour;
+  ObjectFusion fusion(intrinsics, options);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.2, 1, 0.3).normalized();
+  auto truth = [&](int i) {
+    return Rigid3::Translation({10, 5, 520}) *
+           Rigid3::FromAxisAngle(axis, 2.0 * std::max(0, i - kStill) * M_PI / 180);
+  };
+  Rigid3 first, last;
+  for (int i = 0; i < kFrames; ++i) {
+    const Frame frame = Ball(intrinsics, truth(i), /*patterned=*/true, rng);
+    std::vector<std::uint8_t> mask(frame.depth_mm.size());
+    for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+    const FusionResult result = fusion.Fuse({&frame, &mask, {}});
+    EXPECT_NE(result.status, FusionStatus::kSkipped) << "frame " << i << ": " << result.reason;
+    (i == 0 ? first : last) = result.cam_from_object;
+  }
+  // The volume is fixed to the ball: cam_from_volume(i) = truth(i)·object_from_volume.
+  const Rigid3 expected = truth(kFrames - 1) * truth(0).Inverse() * first;
+  const double error = TurnDeg(last, expected);
+  std::printf("patterned ball turned %d° with %s: %.2f° off at the end\n",
+              2 * (kFrames - 1 - kStill), colour ? "its colours" : "nothing", error);
+  return error;
+}
+
+TEST(ColourAlignTest, APatternedBallTurnedWithNothingElseToRegisterItFollowsByItsColours) {
+  EXPECT_LT(TurnedBallEndError(true), 5.0);
+  EXPECT_GT(TurnedBallEndError(false), 90.0) << "the surface alone kept the turn: no test";
+}
+
+TEST(ColourAlignTest, WithoutFreeDirectionsOrColourNothingRuns) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  const Frame frame = Frame::Blank(intrinsics.width, intrinsics.height, /*with_color=*/false);
+  const std::vector<std::uint8_t> mask(frame.depth_mm.size(), 1);
+  RaycastImage model;
+  const ColourAlignResult none =
+      AlignColour(frame, mask, {0, 0, 10, 10}, model, intrinsics, Rigid3(), {}, {});
+  EXPECT_FALSE(none.applied);
+  EXPECT_EQ(none.reason, "no free direction");
+  const ColourAlignResult grey = AlignColour(frame, mask, {0, 0, 10, 10}, model, intrinsics,
+                                             Rigid3(), {{{0, 1, 0}, {0, 0, 0}}}, {});
+  EXPECT_FALSE(grey.applied);
+  EXPECT_EQ(grey.reason, "no colour");
+  ColourAlignOptions bad;
+  bad.prior_mm = 0;
+  EXPECT_THROW(bad.Check(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ihs::fusion
