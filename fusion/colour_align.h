@@ -8,12 +8,14 @@
 // et al. 2011 and Park et al. 2017's coloured ICP, here only where the shape says nothing). The
 // frame is then registered against everything fused before, not chained to the last frame.
 //
-// Both grey images are blurred (a normalised Gaussian within the object's pixels: the model's
-// colour is that of 1.4 mm voxels and a mean over many frames), coarse to fine; a gain and an
-// offset take up the difference in exposure and shading; residuals weigh by Huber's rule; the
-// motion stays near ICP's under a Gaussian prior (ColourAlignOptions::prior_mm), so that where
-// the object has no pattern (a uniform ball: the model's grey does not change along its turn)
-// nothing moves.
+// Both grey images are compared over the pixels both hold, as the log of the grey less its
+// slow changes, less what the surface's normals explain (the shading, which a spin does not
+// move: left in, it held uniform bottles still); where that leaves no pattern in the frame or
+// the model, nothing moves. Then both are blurred (a normalised Gaussian within the object's
+// pixels: the model's colour is that of 1.4 mm voxels and a mean over many frames), coarse to
+// fine; a gain and an offset take up the difference in exposure; residuals weigh by Huber's
+// rule; the motion stays near ICP's under a Gaussian prior (ColourAlignOptions::prior_mm), each
+// direction as far as the colour's basin holds it.
 
 #include <Eigen/Core>
 #include <array>
