@@ -144,7 +144,8 @@ TEST(ColourAlignTest, APatternedBallsFreeTurnIsFoundByItsColours) {
     const Outcome out = AlignTurnedBall(/*patterned=*/true, turn);
     EXPECT_GT(out.icp_off_deg, 0.6 * turn) << "ICP kept the free turn: the test needs it to";
     EXPECT_TRUE(out.colour.applied) << out.colour.reason;
-    EXPECT_LT(out.colour_off_deg, std::min(1.0, 0.3 * out.icp_off_deg));
+    // Measured: 0.19° and 0.22° off.
+    EXPECT_LT(out.colour_off_deg, 0.5);
     EXPECT_LT(out.centre_off_mm, 0.5) << "what the surface fixed stays fixed";
     EXPECT_LT(out.colour.uncertainty_mm, 0.3);
   }
@@ -190,7 +191,8 @@ double TurnedBallEndError(bool colour) {
 }
 
 TEST(ColourAlignTest, APatternedBallTurnedWithNothingElseToRegisterItFollowsByItsColours) {
-  EXPECT_LT(TurnedBallEndError(true), 5.0);
+  // Measured: 1.42° off after 178°.
+  EXPECT_LT(TurnedBallEndError(true), 3.0);
   EXPECT_GT(TurnedBallEndError(false), 90.0) << "the surface alone kept the turn: no test";
 }
 
