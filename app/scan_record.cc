@@ -149,6 +149,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["icp_points"] = fused.icp.points;
       if (fused.icp.slid) entry["icp_slid"] = true, ++icp_slid_frames_;
       if (fused.icp.free_directions >= 0) entry["icp_free_directions"] = fused.icp.free_directions;
+      if (fused.icp.contour_pairs > 0) entry["icp_contour_pairs"] = fused.icp.contour_pairs;
       entry["icp_rms_mm"] = fused.icp.rms_mm;
     }
   }

@@ -419,6 +419,19 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
   r.Add("fusion.icp_contacts_need_spread", &u.icp_contacts_need_spread,
         "contacts hold ICP only when spread like pairwise.min_contact_spread_mm asks (off: one "
         "fingertip's patch holds it too, in the directions the surface leaves free)");
+  r.Add("fusion.silhouette.weight", &u.silhouette.weight,
+        "ICP holds the object's outline against the background to the model's edge; each "
+        "outline point weighs this many surface pairs (0: off)");
+  r.Add("fusion.silhouette.search_px", &u.silhouette.search_px,
+        "how far along the outline's normal the model's edge is looked for, pixels");
+  r.Add("fusion.silhouette.background_gap_mm", &u.silhouette.background_gap_mm,
+        "a pixel next to the object is background when it lies this much farther or has no "
+        "depth, mm");
+  r.Add("fusion.silhouette.max_points", &u.silhouette.max_points,
+        "outline points ICP uses at most");
+  r.Add("fusion.silhouette.min_edge_facing", &u.silhouette.min_edge_facing,
+        "the model's edge counts where its surface faces the camera at least this much (cosine; "
+        "a crease, not a ball's outline)");
   r.Add("fusion.colour.enabled", &u.colour.enabled,
         "after ICP, the object's colours are aligned to the model's in the directions its "
         "surface leaves free (a patterned ball's or bottle's turn)");

@@ -80,7 +80,7 @@ class Aligner {
  public:
   Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
           const CameraIntrinsics& intrinsics, const IcpOptions& options,
-          const std::vector<IcpAnchor>& anchors);
+          const std::vector<IcpAnchor>& anchors, const IcpContour* contour);
 
   // Runs the Gauss–Newton iterations until they converge, fail or run out; then, if the last
   // one lost most of the pairs the first had, goes back to the iterate that paired the most.
@@ -93,6 +93,7 @@ class Aligner {
   double rms() const { return rms_; }
   int iterations() const { return iterations_; }
   int free_directions() const { return free_directions_; }
+  int contour_pairs() const { return contour_pairs_; }
   const Eigen::Vector3d& pivot() const { return pivot_; }
   const std::vector<FreeDirection>& free() const { return free_; }
   const Eigen::Vector3d& free_centre() const { return free_centre_; }
@@ -103,6 +104,11 @@ class Aligner {
   // The point pairs' equations at the current correction (counts the inliers, sets the rms);
   // with `lines`, also gathers the model's normal lines.
   Equations PairPoints(NormalLines* lines);
+  // The contour points' equations (IcpContour), about the current centre.
+  Equations PairContour();
+  // `equations` restricted to the directions (columns of `basis`) not in `free`.
+  static Equations Outside(const Equations& equations, const Matrix6& basis,
+                           const std::vector<int>& free);
   // The model surface paired with `p` (current camera, corrected), if it is near enough.
   bool FindPair(const Eigen::Vector3d& p, ModelPair* pair) const;
   // Adds a pair's normal line and normal noise to `lines`.
@@ -115,14 +121,17 @@ class Aligner {
   Equations AnchorEquations() const;
   // The Jacobian row of a point `p` moved along `direction` by the twist about the centre.
   Vector6 Row(const Eigen::Vector3d& p, const Eigen::Vector3d& direction) const;
-  // The step the (damped) equations ask for.
-  Vector6 Solve(Equations surface, const Equations& anchored);
-  // The step in the directions the surface constrains, the anchors' in the others.
-  Vector6 SolveConstrained(const Equations& surface, const Equations& anchored);
+  // The step the (damped) equations ask for; `outline` joins the surface where it has not yet.
+  Vector6 Solve(Equations surface, const Equations& anchored, const Equations& outline);
+  // The step in the directions the surface constrains (with the outline's help there), the
+  // anchors' in the others.
+  Vector6 SolveConstrained(const Equations& surface, const Equations& anchored,
+                           const Equations& outline);
   // Lists the directions the surface leaves free (free_), where its constraint (an eigenvalue
-  // of `surface` per pair) is within min_constraint_over_noise of the normals' noise; returns
+  // of `surface` per pair) is within min_constraint_over_noise of the normals' noise, unless
+  // the direction is mostly a shift and the `outline` constrains it above that floor; returns
   // the eigen decomposition and the free directions' indices into it.
-  std::vector<int> JudgeFree(const Equations& surface,
+  std::vector<int> JudgeFree(const Equations& surface, const Equations& outline,
                              Eigen::SelfAdjointEigenSolver<Matrix6>* eigen = nullptr);
   // Applies `step` (a twist about the centre) to the correction.
   void ApplyStep(const Vector6& step);
@@ -132,7 +141,9 @@ class Aligner {
   const CameraIntrinsics& intrinsics_;
   const IcpOptions& options_;
   const std::vector<IcpAnchor>& anchors_;
+  const IcpContour* contour_;
   const double max_sq_;
+  int contour_pairs_ = 0;
   // predicted_from_current: takes the current camera's points to where the predicted camera
   // sees the same surface (the model's raycast).
   Rigid3 correction_;
@@ -166,12 +177,13 @@ class Aligner {
 
 Aligner::Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                  const CameraIntrinsics& intrinsics, const IcpOptions& options,
-                 const std::vector<IcpAnchor>& anchors)
+                 const std::vector<IcpAnchor>& anchors, const IcpContour* contour)
     : points_(points),
       model_(model),
       intrinsics_(intrinsics),
       options_(options),
       anchors_(anchors),
+      contour_(contour),
       max_sq_(options.max_distance_mm * options.max_distance_mm) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3f& point : points) centroid += point.cast<double>();
@@ -215,13 +227,21 @@ bool Aligner::Iterate(int iteration) {
   }
   if (judge_aside && iteration == 0) MeasureNormalNoise(&lines.jitter);
   const Equations anchored = AnchorEquations();
-  if (judge_aside && noise_information_ > 0) JudgeFree(surface);
+  // The free directions are the surface's alone: an outline's normals are noisy enough to make
+  // a ball's turn look fixed, though its outline says nothing of that turn.
+  const Equations outline = PairContour();
+  Equations held = outline;
+  if (judge_aside && noise_information_ > 0) {
+    Eigen::SelfAdjointEigenSolver<Matrix6> eigen;
+    const std::vector<int> free = JudgeFree(surface, outline, &eigen);
+    held = Outside(outline, eigen.eigenvectors(), free);
+  }
   if (!keep_free_) {
-    surface.matrix += anchored.matrix;
-    surface.rhs += anchored.rhs;
+    surface.matrix += anchored.matrix + held.matrix;
+    surface.rhs += anchored.rhs + held.rhs;
   }
   if (inliers_ < 6) return false;
-  const Vector6 step = Solve(std::move(surface), anchored);
+  const Vector6 step = Solve(std::move(surface), anchored, outline);
   if (!step.allFinite()) return false;
   ApplyStep(step);
   iterations_ = iteration + 1;
@@ -252,6 +272,30 @@ Equations Aligner::PairPoints(NormalLines* lines) {
   return surface;
 }
 
+Equations Aligner::PairContour() {
+  Equations outline;
+  contour_pairs_ = 0;
+  if (!contour_ || !(contour_->weight > 0)) return outline;
+  for (const ContourPoint& point : contour_->points) {
+    const Eigen::Vector3d p = correction_ * point.point;
+    const Eigen::Vector2d normal =
+        (correction_.rotation() * Eigen::Vector3d(point.normal.x(), point.normal.y(), 0))
+            .head<2>()
+            .normalized();
+    Eigen::Vector3d direction;
+    double residual = 0;
+    if (!PairContourPoint(p, normal, model_, intrinsics_, options_.max_distance_mm,
+                          contour_->search_px, contour_->min_edge_facing, &direction, &residual)) {
+      continue;
+    }
+    const Vector6 row = Row(p, direction);
+    outline.matrix += contour_->weight * row * row.transpose();
+    outline.rhs -= contour_->weight * row * residual;
+    ++contour_pairs_;
+  }
+  return outline;
+}
+
 bool Aligner::FindPair(const Eigen::Vector3d& p, ModelPair* pair) const {
   if (p.z() <= 0) return false;
   const Eigen::Vector2d pixel = intrinsics_.Project(p);
@@ -263,6 +307,7 @@ bool Aligner::FindPair(const Eigen::Vector3d& p, ModelPair* pair) const {
   pair->depth = model_.depth_mm[pair->index];
   pair->normal = model_.normals[pair->index].cast<double>();
   if (pair->depth <= 0 || pair->normal.squaredNorm() < 0.5) return false;
+  if (contour_ && contour_->pairable && !(*contour_->pairable)[pair->index]) return false;
   pair->target = intrinsics_.BackProject(pair->u, pair->v, pair->depth);
   return !((p - pair->target).squaredNorm() > max_sq_);
 }
@@ -336,35 +381,62 @@ Equations Aligner::AnchorEquations() const {
   return anchored;
 }
 
+Equations Aligner::Outside(const Equations& equations, const Matrix6& basis,
+                           const std::vector<int>& free) {
+  Matrix6 keep = Matrix6::Zero();
+  for (int i = 0; i < 6; ++i) {
+    if (std::find(free.begin(), free.end(), i) == free.end())
+      keep += basis.col(i) * basis.col(i).transpose();
+  }
+  Equations kept;
+  kept.matrix = keep * equations.matrix * keep;
+  kept.rhs = keep * equations.rhs;
+  return kept;
+}
+
 Vector6 Aligner::Row(const Eigen::Vector3d& p, const Eigen::Vector3d& direction) const {
   Vector6 row;
   row << ((p - centre_) / scale_).cross(direction), direction;
   return row;
 }
 
-Vector6 Aligner::Solve(Equations surface, const Equations& anchored) {
+Vector6 Aligner::Solve(Equations surface, const Equations& anchored, const Equations& outline) {
   // A little (Marquardt) damping keeps directions the data do not constrain at all where the
   // prediction put them.
   surface.matrix.diagonal() *= 1.0 + 1e-4;
   surface.matrix.diagonal().array() += 1e-9;
-  if (keep_free_ && noise_information_ > 0) return SolveConstrained(surface, anchored);
+  if (keep_free_ && noise_information_ > 0) return SolveConstrained(surface, anchored, outline);
   if (keep_free_) {
     // No measure of the normals' noise to tell free directions by: the anchors join in.
-    return (surface.matrix + anchored.matrix).ldlt().solve(surface.rhs + anchored.rhs);
+    return (surface.matrix + anchored.matrix + outline.matrix)
+        .ldlt()
+        .solve(surface.rhs + anchored.rhs + outline.rhs);
   }
   return surface.matrix.ldlt().solve(surface.rhs);
 }
 
-Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anchored) {
+Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anchored,
+                                  const Equations& outline) {
   // Only the directions the surface constrains move; the others keep the prediction, or
   // follow the anchors where they have any.
   Eigen::SelfAdjointEigenSolver<Matrix6> eigen;
-  const std::vector<int> free = JudgeFree(surface, &eigen);
+  const std::vector<int> free = JudgeFree(surface, outline, &eigen);
   Vector6 step = Vector6::Zero();
-  for (int i = 0; i < 6; ++i) {
-    if (std::find(free.begin(), free.end(), i) != free.end()) continue;
-    const auto direction = eigen.eigenvectors().col(i);
-    step += direction * (direction.dot(surface.rhs) / eigen.eigenvalues()[i]);
+  if (contour_pairs_ > 0 && free.size() < 6) {
+    // The surface and the outline together, within the directions the surface constrains.
+    Eigen::MatrixXd fixed(6, 6 - static_cast<int>(free.size()));
+    for (int i = 0, c = 0; i < 6; ++i) {
+      if (std::find(free.begin(), free.end(), i) == free.end())
+        fixed.col(c++) = eigen.eigenvectors().col(i);
+    }
+    const Eigen::MatrixXd reduced = fixed.transpose() * (surface.matrix + outline.matrix) * fixed;
+    step = fixed * reduced.ldlt().solve(fixed.transpose() * (surface.rhs + outline.rhs));
+  } else {
+    for (int i = 0; i < 6; ++i) {
+      if (std::find(free.begin(), free.end(), i) != free.end()) continue;
+      const auto direction = eigen.eigenvectors().col(i);
+      step += direction * (direction.dot(surface.rhs) / eigen.eigenvalues()[i]);
+    }
   }
   free_directions_ = static_cast<int>(free.size());
   if (!free.empty() && !anchors_.empty())
@@ -372,7 +444,7 @@ Vector6 Aligner::SolveConstrained(const Equations& surface, const Equations& anc
   return step;
 }
 
-std::vector<int> Aligner::JudgeFree(const Equations& surface,
+std::vector<int> Aligner::JudgeFree(const Equations& surface, const Equations& outline,
                                     Eigen::SelfAdjointEigenSolver<Matrix6>* eigen) {
   Eigen::SelfAdjointEigenSolver<Matrix6> own;
   if (!eigen) eigen = &own;
@@ -384,8 +456,11 @@ std::vector<int> Aligner::JudgeFree(const Equations& surface,
   for (int i = 0; i < 6; ++i) {
     const double value = eigen->eigenvalues()[i];
     if (!(value <= floor || value <= 0)) continue;
-    free.push_back(i);
     const auto direction = eigen->eigenvectors().col(i);
+    // A face seen head-on leaves its shifts along itself free; its outline fixes them.
+    const bool shift = direction.tail<3>().norm() > direction.head<3>().norm();
+    if (shift && contour_pairs_ > 0 && direction.dot(outline.matrix * direction) > floor) continue;
+    free.push_back(i);
     free_.push_back({direction.head<3>() / scale_, direction.tail<3>()});
   }
   return free;
@@ -413,14 +488,18 @@ void CheckEnoughPairs(int needed, size_t point_count, IcpResult* result) {
 
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
-                       const IcpOptions& options, const std::vector<IcpAnchor>& anchors) {
+                       const IcpOptions& options, const std::vector<IcpAnchor>& anchors,
+                       const IcpContour* contour) {
   options.Check();
   IHS_CHECK_ARG(model.width == intrinsics.width && model.height == intrinsics.height,
                 "the raycast is " << model.width << "x" << model.height << ", the camera "
                                   << intrinsics.width << "x" << intrinsics.height);
   const int needed =
       std::max(50, static_cast<int>(std::ceil(options.min_inlier_fraction * points.size())));
-  Aligner aligner(points, model, intrinsics, options, anchors);
+  IHS_CHECK_ARG(
+      !contour || !contour->pairable || contour->pairable->size() == model.depth_mm.size(),
+      "the contour's pairable mask does not cover the raycast");
+  Aligner aligner(points, model, intrinsics, options, anchors, contour);
   aligner.Run();
   IcpResult result;
   result.iterations = aligner.iterations();
@@ -433,6 +512,7 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   result.pivot = aligner.pivot();
   result.free = aligner.free();
   result.free_centre = aligner.free_centre();
+  result.contour_pairs = aligner.contour_pairs();
   // correction · current = predicted (as seen): cam_from_volume = correction⁻¹ · predicted.
   result.cam_from_volume = aligner.correction().Inverse() * predicted;
   CheckEnoughPairs(needed, points.size(), &result);

@@ -10,6 +10,7 @@
 
 #include "core/camera_intrinsics.h"
 #include "core/rigid3.h"
+#include "fusion/silhouette.h"
 #include "fusion/tsdf_volume.h"
 
 namespace ihs::fusion {
@@ -98,6 +99,21 @@ struct IcpResult {
   /// (turn in radians, shift in mm; unit vectors of ICP's scaled twist). Empty where none.
   std::vector<FreeDirection> free;
   Eigen::Vector3d free_centre = Eigen::Vector3d::Zero();
+  /// Contour points paired with the model's edge in the last iteration (IcpContour).
+  int contour_pairs = 0;
+};
+
+/// The frame's occluding contour for ICP's silhouette term (silhouette.h): each point that
+/// finds the model's edge within `search_px` along its outline's normal adds a row of
+/// `weight` (in surface pairs). The model raycast then reaches beyond the object's pixels
+/// (MarkContourBand); `pairable` (the frame's object mask) keeps the surface pairs where they
+/// were.
+struct IcpContour {
+  std::vector<ContourPoint> points;
+  const std::vector<std::uint8_t>* pairable = nullptr;
+  double weight = 1.0;
+  int search_px = 4;
+  double min_edge_facing = 0.3;
 };
 
 /// A point of the current frame (camera frame, mm) that must land at `target`, where the
@@ -112,9 +128,10 @@ struct IcpAnchor {
 
 /// Aligns `points` (the current frame's object points, camera frame, mm) to `model` (the TSDF
 /// raycast at `predicted`, the predicted cam_from_volume) seen by a camera with `intrinsics`,
-/// together with `anchors`.
+/// together with `anchors` and, where given, the frame's `contour`.
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
-                       const IcpOptions& options = {}, const std::vector<IcpAnchor>& anchors = {});
+                       const IcpOptions& options = {}, const std::vector<IcpAnchor>& anchors = {},
+                       const IcpContour* contour = nullptr);
 
 }  // namespace ihs::fusion

@@ -33,6 +33,7 @@ void FusionOptions::Check() const {
   free_space.Check();
   loop_closure.Check();
   colour.Check();
+  silhouette.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -461,6 +462,18 @@ ObjectFusion::IcpSetup ObjectFusion::PrepareIcp(const ObjectPixels& object, cons
       if (object.mask[pixel]) near_depth_[pixel] = object.frame.depth_mm[pixel];
     }
   }
+  if (options_.silhouette.weight > 0) {
+    // The model's edge is looked for beyond the object's pixels too (by ICP's correction
+    // farther still).
+    setup.contour.points =
+        FindContour(object.frame, object.mask, object.box, intrinsics_, options_.silhouette);
+    MarkContourBand(setup.contour.points, intrinsics_, options_.silhouette.search_px + 3,
+                    &near_depth_);
+    setup.contour.pairable = &object.mask;
+    setup.contour.weight = options_.silhouette.weight;
+    setup.contour.search_px = options_.silhouette.search_px;
+    setup.contour.min_edge_facing = options_.silhouette.min_edge_facing;
+  }
   setup.window = static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
   setup.options = options_.icp;
   // Contacts that fix a point but hardly a turn decide only what the surface leaves free.
@@ -480,8 +493,8 @@ IcpResult ObjectFusion::AlignAt(const ObjectPixels& object, const IcpSetup& setu
   model_image_pose_ = predicted;
   result->raycast_ms += MillisecondsSince(raycast_start);
   const auto icp_start = SteadyClock::now();
-  IcpResult icp =
-      AlignToModel(object.points, model_image_, intrinsics_, predicted, setup.options, anchors);
+  IcpResult icp = AlignToModel(object.points, model_image_, intrinsics_, predicted, setup.options,
+                               anchors, setup.contour.points.empty() ? nullptr : &setup.contour);
   result->icp_ms += MillisecondsSince(icp_start);
   return icp;
 }

@@ -49,6 +49,9 @@ struct FusionOptions {
   /// After ICP, the frame's colours against the model's in the directions the surface leaves
   /// free (colour_align.h).
   ColourAlignOptions colour;
+  /// ICP's silhouette term: the frame's outline against the background held to the model's
+  /// edge (silhouette.h).
+  SilhouetteOptions silhouette;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -274,6 +277,8 @@ class ObjectFusion {
     std::array<int, 4> roi;
     float window = 0;
     IcpOptions options;
+    // The frame's occluding contour (FusionOptions::silhouette); no points where it is off.
+    IcpContour contour;
   };
 
   // Completes `result` with `status` and `reason`, keeps the hand and the coverage of a
