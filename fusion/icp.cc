@@ -275,7 +275,7 @@ Equations Aligner::PairPoints(NormalLines* lines) {
 Equations Aligner::PairContour() {
   Equations outline;
   contour_pairs_ = 0;
-  if (!contour_ || !(contour_->weight > 0)) return outline;
+  if (!contour_ || !(contour_->options.weight > 0)) return outline;
   for (const ContourPoint& point : contour_->points) {
     const Eigen::Vector3d p = correction_ * point.point;
     const Eigen::Vector2d normal =
@@ -285,12 +285,13 @@ Equations Aligner::PairContour() {
     Eigen::Vector3d direction;
     double residual = 0;
     if (!PairContourPoint(p, normal, model_, intrinsics_, options_.max_distance_mm,
-                          contour_->search_px, contour_->min_edge_facing, &direction, &residual)) {
+                          contour_->options.search_px, contour_->options.min_edge_facing,
+                          &direction, &residual)) {
       continue;
     }
     const Vector6 row = Row(p, direction);
-    outline.matrix += contour_->weight * row * row.transpose();
-    outline.rhs -= contour_->weight * row * residual;
+    outline.matrix += contour_->options.weight * row * row.transpose();
+    outline.rhs -= contour_->options.weight * row * residual;
     ++contour_pairs_;
   }
   return outline;

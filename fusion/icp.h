@@ -104,16 +104,14 @@ struct IcpResult {
 };
 
 /// The frame's occluding contour for ICP's silhouette term (silhouette.h): each point that
-/// finds the model's edge within `search_px` along its outline's normal adds a row of
-/// `weight` (in surface pairs). The model raycast then reaches beyond the object's pixels
-/// (MarkContourBand); `pairable` (the frame's object mask) keeps the surface pairs where they
-/// were.
+/// finds the model's edge within `options.search_px` along its outline's normal adds a row of
+/// `options.weight` (in surface pairs). The model raycast then reaches beyond the object's
+/// pixels (MarkContourBand); `pairable` (the frame's object mask) keeps the surface pairs where
+/// they were.
 struct IcpContour {
   std::vector<ContourPoint> points;
   const std::vector<std::uint8_t>* pairable = nullptr;
-  double weight = 1.0;
-  int search_px = 4;
-  double min_edge_facing = 0.3;
+  SilhouetteOptions options;
 };
 
 /// A point of the current frame (camera frame, mm) that must land at `target`, where the

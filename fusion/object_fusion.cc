@@ -470,9 +470,7 @@ ObjectFusion::IcpSetup ObjectFusion::PrepareIcp(const ObjectPixels& object, cons
     MarkContourBand(setup.contour.points, intrinsics_, options_.silhouette.search_px + 3,
                     &near_depth_);
     setup.contour.pairable = &object.mask;
-    setup.contour.weight = options_.silhouette.weight;
-    setup.contour.search_px = options_.silhouette.search_px;
-    setup.contour.min_edge_facing = options_.silhouette.min_edge_facing;
+    setup.contour.options = options_.silhouette;
   }
   setup.window = static_cast<float>(2 * options_.icp.max_distance_mm + volume_.truncation_mm());
   setup.options = options_.icp;
