@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
 
@@ -56,92 +57,58 @@ struct GreyPatch {
 
 float Grey(const std::uint8_t* rgb) { return 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2]; }
 
-// Runs `filter` over every row (`along_rows`) or column of `values` and `weights` (width ×
-// height, row-major): it gets the line's values and weights and writes its results back into
-// them.
-template <typename Filter>
-void FilterLines(int width, int height, bool along_rows, std::vector<float>* values,
-                 std::vector<float>* weights, Filter&& filter) {
-  const int length = along_rows ? width : height, lines = along_rows ? height : width;
-  std::vector<float> value_line(length), weight_line(length);
-  for (int line = 0; line < lines; ++line) {
-    auto at = [&](int i) {
-      return along_rows ? static_cast<size_t>(line) * width + i
-                        : static_cast<size_t>(i) * width + line;
-    };
-    for (int i = 0; i < length; ++i)
-      value_line[i] = (*values)[at(i)], weight_line[i] = (*weights)[at(i)];
-    filter(value_line, weight_line, [&](int i, float value, float weight) {
-      (*values)[at(i)] = value, (*weights)[at(i)] = weight;
-    });
+// `image`'s sums under a Gaussian of `sigma` pixels, nothing beyond its border (in place).
+// Wide blurs are three boxes each way (the same spread, near enough: a few hundred pixels'
+// blur costs what a narrow one does).
+void GaussianSums(cv::Mat* image, double sigma) {
+  const int radius = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
+  if (radius <= 4) {
+    cv::Mat kernel(2 * radius + 1, 1, CV_32F);
+    for (int k = -radius; k <= radius; ++k)
+      kernel.at<float>(k + radius) = static_cast<float>(std::exp(-0.5 * k * k / (sigma * sigma)));
+    cv::sepFilter2D(*image, *image, CV_32F, kernel, kernel, cv::Point(-1, -1), 0,
+                    cv::BORDER_CONSTANT);
+    return;
+  }
+  // Three boxes of 2r + 1 have the variance of a Gaussian's sigma² = (2r + 1)² − 1) / 4.
+  const int box =
+      std::max(1, static_cast<int>(std::lround((std::sqrt(4 * sigma * sigma + 1) - 1) / 2)));
+  for (int pass = 0; pass < 3; ++pass) {
+    cv::boxFilter(*image, *image, CV_32F, cv::Size(2 * box + 1, 2 * box + 1), cv::Point(-1, -1),
+                  /*normalize=*/false, cv::BORDER_CONSTANT);
   }
 }
 
-// One pass of a Gaussian along rows or columns over `values` weighed by `weights` (both in
-// place: the weighted sums and the weights' sums).
-void BlurPass(int width, int height, const std::vector<float>& kernel, bool along_rows,
-              std::vector<float>* values, std::vector<float>* weights) {
-  const int radius = static_cast<int>(kernel.size()) / 2;
-  FilterLines(width, height, along_rows, values, weights,
-              [&](const std::vector<float>& v, const std::vector<float>& w, auto&& put) {
-                const int length = static_cast<int>(v.size());
-                for (int i = 0; i < length; ++i) {
-                  float value = 0, weight = 0;
-                  for (int k = std::max(-radius, -i); k <= radius && i + k < length; ++k) {
-                    value += kernel[k + radius] * v[i + k];
-                    weight += kernel[k + radius] * w[i + k];
-                  }
-                  put(i, value, weight);
-                }
-              });
-}
-
-// A box of radius `radius`, as BlurPass (a running sum: its cost does not grow with the radius).
-void BoxPass(int width, int height, int radius, bool along_rows, std::vector<float>* values,
-             std::vector<float>* weights) {
-  FilterLines(width, height, along_rows, values, weights,
-              [&](const std::vector<float>& v, const std::vector<float>& w, auto&& put) {
-                const int length = static_cast<int>(v.size());
-                double value = 0, weight = 0;
-                for (int i = 0; i < std::min(radius, length); ++i) value += v[i], weight += w[i];
-                for (int i = 0; i < length; ++i) {
-                  if (i + radius < length) value += v[i + radius], weight += w[i + radius];
-                  if (i - radius - 1 >= 0) value -= v[i - radius - 1], weight -= w[i - radius - 1];
-                  put(i, static_cast<float>(value), static_cast<float>(weight));
-                }
-              });
+// The sums of the pixels `patch` holds (1 each) under GaussianSums: the weights that normalise
+// its blur (Blurred).
+cv::Mat HeldSums(const GreyPatch& patch, double sigma) {
+  cv::Mat weights(patch.height, patch.width, CV_32F);
+  for (size_t i = 0; i < patch.valid.size(); ++i)
+    weights.ptr<float>()[i] = patch.valid[i] ? 1.0f : 0.0f;
+  GaussianSums(&weights, sigma);
+  return weights;
 }
 
 // `patch` blurred by a Gaussian of `sigma` pixels, normalised over the pixels it holds (the
-// edge of the object does not darken what lies near it). Wide blurs are three boxes each way
-// (the same spread, near enough: a few hundred pixels' blur costs what a narrow one does).
-GreyPatch Blurred(const GreyPatch& patch, double sigma) {
-  std::vector<float> values(patch.grey.size()), weights(patch.grey.size());
-  for (size_t i = 0; i < values.size(); ++i) {
-    weights[i] = patch.valid[i] ? 1.0f : 0.0f;
-    values[i] = weights[i] * patch.grey[i];
-  }
-  const int radius = std::max(1, static_cast<int>(std::ceil(3 * sigma)));
-  if (radius <= 4) {
-    std::vector<float> kernel(2 * radius + 1);
-    for (int k = -radius; k <= radius; ++k)
-      kernel[k + radius] = static_cast<float>(std::exp(-0.5 * k * k / (sigma * sigma)));
-    BlurPass(patch.width, patch.height, kernel, true, &values, &weights);
-    BlurPass(patch.width, patch.height, kernel, false, &values, &weights);
-  } else {
-    // Three boxes of 2r + 1 have the variance of a Gaussian's sigma² = (2r + 1)² − 1) / 4.
-    const int box =
-        std::max(1, static_cast<int>(std::lround((std::sqrt(4 * sigma * sigma + 1) - 1) / 2)));
-    for (int pass = 0; pass < 3; ++pass) {
-      BoxPass(patch.width, patch.height, box, true, &values, &weights);
-      BoxPass(patch.width, patch.height, box, false, &values, &weights);
-    }
-  }
+// edge of the object does not darken what lies near it); `held`: HeldSums(patch, sigma), where
+// several patches that hold the same pixels share it.
+GreyPatch Blurred(const GreyPatch& patch, double sigma, const cv::Mat& held) {
   GreyPatch blurred = patch;
-  for (size_t i = 0; i < values.size(); ++i) {
-    if (patch.valid[i] && weights[i] > 0) blurred.grey[i] = values[i] / weights[i];
+  if (patch.grey.empty()) return blurred;
+  cv::Mat values(patch.height, patch.width, CV_32F);
+  for (size_t i = 0; i < patch.grey.size(); ++i)
+    values.ptr<float>()[i] = patch.valid[i] ? patch.grey[i] : 0.0f;
+  GaussianSums(&values, sigma);
+  for (size_t i = 0; i < patch.grey.size(); ++i) {
+    const float weight = held.ptr<float>()[i];
+    if (patch.valid[i] && weight > 0) blurred.grey[i] = values.ptr<float>()[i] / weight;
   }
   return blurred;
+}
+
+GreyPatch Blurred(const GreyPatch& patch, double sigma) {
+  if (patch.grey.empty()) return patch;
+  return Blurred(patch, sigma, HeldSums(patch, sigma));
 }
 
 // The standard deviation of what `patch` holds.
@@ -216,8 +183,11 @@ double RemoveShading(const RaycastImage& model, const CameraIntrinsics& intrinsi
         features[f].grey[at] = static_cast<float>(100 * values[f]);
     }
   }
+  // The features hold the same pixels: one blur of them normalises every feature's.
+  const cv::Mat held = grid.grey.empty() ? cv::Mat() : HeldSums(grid, sigma);
   for (GreyPatch& feature : features) {
-    const GreyPatch smooth = Blurred(feature, sigma);
+    if (feature.grey.empty()) continue;
+    const GreyPatch smooth = Blurred(feature, sigma, held);
     for (size_t i = 0; i < feature.grey.size(); ++i) {
       if (feature.valid[i]) feature.grey[i] -= smooth.grey[i];
     }
