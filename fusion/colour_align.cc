@@ -183,13 +183,22 @@ double RemoveShading(const RaycastImage& model, const CameraIntrinsics& intrinsi
         features[f].grey[at] = static_cast<float>(100 * values[f]);
     }
   }
-  // The features hold the same pixels: one blur of them normalises every feature's.
-  const cv::Mat held = grid.grey.empty() ? cv::Mat() : HeldSums(grid, sigma);
-  for (GreyPatch& feature : features) {
-    if (feature.grey.empty()) continue;
-    const GreyPatch smooth = Blurred(feature, sigma, held);
-    for (size_t i = 0; i < feature.grey.size(); ++i) {
-      if (feature.valid[i]) feature.grey[i] -= smooth.grey[i];
+  // Each feature less its blur (as the details are), all eight blurred in one image of eight
+  // channels; they hold the same pixels, so one blur of those normalises them all.
+  if (!grid.grey.empty()) {
+    const cv::Mat held = HeldSums(grid, sigma);
+    cv::Mat stack(grid.height, grid.width, CV_32FC(kFeatures));
+    float* sums = stack.ptr<float>();
+    for (size_t i = 0; i < grid.grey.size(); ++i) {
+      for (int f = 0; f < kFeatures; ++f)
+        sums[i * kFeatures + f] = grid.valid[i] ? features[f].grey[i] : 0.0f;
+    }
+    GaussianSums(&stack, sigma);
+    sums = stack.ptr<float>();
+    for (size_t i = 0; i < grid.grey.size(); ++i) {
+      const float weight = held.ptr<float>()[i];
+      if (!grid.valid[i] || !(weight > 0)) continue;
+      for (int f = 0; f < kFeatures; ++f) features[f].grey[i] -= sums[i * kFeatures + f] / weight;
     }
   }
   double explained = 0;
