@@ -90,11 +90,11 @@ cv::Mat HeldSums(const GreyPatch& patch, double sigma) {
 }
 
 // `patch` blurred by a Gaussian of `sigma` pixels, normalised over the pixels it holds (the
-// edge of the object does not darken what lies near it); `held`: HeldSums(patch, sigma), where
-// several patches that hold the same pixels share it.
-GreyPatch Blurred(const GreyPatch& patch, double sigma, const cv::Mat& held) {
+// edge of the object does not darken what lies near it).
+GreyPatch Blurred(const GreyPatch& patch, double sigma) {
   GreyPatch blurred = patch;
   if (patch.grey.empty()) return blurred;
+  const cv::Mat held = HeldSums(patch, sigma);
   cv::Mat values(patch.height, patch.width, CV_32F);
   for (size_t i = 0; i < patch.grey.size(); ++i)
     values.ptr<float>()[i] = patch.valid[i] ? patch.grey[i] : 0.0f;
@@ -104,11 +104,6 @@ GreyPatch Blurred(const GreyPatch& patch, double sigma, const cv::Mat& held) {
     if (patch.valid[i] && weight > 0) blurred.grey[i] = values.ptr<float>()[i] / weight;
   }
   return blurred;
-}
-
-GreyPatch Blurred(const GreyPatch& patch, double sigma) {
-  if (patch.grey.empty()) return patch;
-  return Blurred(patch, sigma, HeldSums(patch, sigma));
 }
 
 // The standard deviation of what `patch` holds.
