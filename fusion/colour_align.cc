@@ -155,45 +155,39 @@ double RemoveShading(const RaycastImage& model, const CameraIntrinsics& intrinsi
                      GreyPatch* frame_detail, GreyPatch* model_detail) {
   constexpr int kFeatures = 8;
   const GreyPatch& grid = *model_detail;
-  std::array<GreyPatch, kFeatures> features;
-  for (GreyPatch& feature : features) feature = grid;
+  // The features, one image of eight channels (none where the grid holds nothing).
+  cv::Mat features = cv::Mat::zeros(grid.height, grid.width, CV_32FC(kFeatures));
+  auto feature_row = [&](int u, int v) {
+    return Eigen::Map<Eigen::Matrix<float, kFeatures, 1>>(features.ptr<float>() +
+                                                          kFeatures * grid.Index(u, v));
+  };
   for (int v = grid.v0; v < grid.v0 + grid.height; ++v) {
     for (int u = grid.u0; u < grid.u0 + grid.width; ++u) {
-      const size_t at = grid.Index(u, v);
-      if (!grid.valid[at]) continue;
+      if (!grid.valid[grid.Index(u, v)]) continue;
       Eigen::Vector3d n = model.normals[static_cast<size_t>(v) * model.width + u].cast<double>();
       // In the ray's frame, so that a light at the camera shades by n·ray alike everywhere.
       const Eigen::Vector3d ray = intrinsics.BackProject(u, v, 1.0).normalized();
       const double facing = -n.dot(ray);
       const Eigen::Vector3d across = n + facing * ray;
-      const double values[kFeatures] = {facing,
-                                        across.x(),
-                                        across.y(),
-                                        facing * facing,
-                                        across.x() * across.x(),
-                                        across.y() * across.y(),
-                                        across.x() * across.y(),
-                                        facing * across.x()};
-      for (int f = 0; f < kFeatures; ++f)
-        features[f].grey[at] = static_cast<float>(100 * values[f]);
+      const Eigen::Matrix<double, kFeatures, 1> values =
+          (Eigen::Matrix<double, kFeatures, 1>() << facing, across.x(), across.y(), facing * facing,
+           across.x() * across.x(), across.y() * across.y(), across.x() * across.y(),
+           facing * across.x())
+              .finished();
+      feature_row(u, v) = (100 * values).cast<float>();
     }
   }
-  // Each feature less its blur (as the details are), all eight blurred in one image of eight
-  // channels; they hold the same pixels, so one blur of those normalises them all.
+  // Each feature less its blur (as the details are), all eight blurred at once; they hold the
+  // same pixels, so one blur of those normalises them all.
   if (!grid.grey.empty()) {
     const cv::Mat held = HeldSums(grid, sigma);
-    cv::Mat stack(grid.height, grid.width, CV_32FC(kFeatures));
-    float* sums = stack.ptr<float>();
-    for (size_t i = 0; i < grid.grey.size(); ++i) {
-      for (int f = 0; f < kFeatures; ++f)
-        sums[i * kFeatures + f] = grid.valid[i] ? features[f].grey[i] : 0.0f;
-    }
-    GaussianSums(&stack, sigma);
-    sums = stack.ptr<float>();
+    cv::Mat sums = features.clone();
+    GaussianSums(&sums, sigma);
     for (size_t i = 0; i < grid.grey.size(); ++i) {
       const float weight = held.ptr<float>()[i];
       if (!grid.valid[i] || !(weight > 0)) continue;
-      for (int f = 0; f < kFeatures; ++f) features[f].grey[i] -= sums[i * kFeatures + f] / weight;
+      for (int f = 0; f < kFeatures; ++f)
+        features.ptr<float>()[i * kFeatures + f] -= sums.ptr<float>()[i * kFeatures + f] / weight;
     }
   }
   double explained = 0;
@@ -207,7 +201,7 @@ double RemoveShading(const RaycastImage& model, const CameraIntrinsics& intrinsi
     for (int v = grid.v0; v < grid.v0 + grid.height; v += 2) {
       for (int u = grid.u0; u < grid.u0 + grid.width; u += 2) {
         if (!grid.Holds(u, v) || !detail->Holds(u, v)) continue;
-        for (int f = 0; f < kFeatures; ++f) row[f] = features[f].grey[grid.Index(u, v)];
+        row = feature_row(u, v).cast<double>();
         const double d = detail->grey[detail->Index(u, v)];
         normal += row * row.transpose();
         rhs += row * d;
@@ -224,7 +218,7 @@ double RemoveShading(const RaycastImage& model, const CameraIntrinsics& intrinsi
     for (int v = grid.v0; v < grid.v0 + grid.height; ++v) {
       for (int u = grid.u0; u < grid.u0 + grid.width; ++u) {
         if (!grid.Holds(u, v) || !detail->Holds(u, v)) continue;
-        for (int f = 0; f < kFeatures; ++f) row[f] = features[f].grey[grid.Index(u, v)];
+        row = feature_row(u, v).cast<double>();
         detail->grey[detail->Index(u, v)] -= static_cast<float>(beta.dot(row));
       }
     }
