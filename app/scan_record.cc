@@ -127,6 +127,9 @@ void ScanRecord::Add(const FramePacket& packet) {
       const Eigen::Quaterniond q = fused.pairwise.current_from_previous.quaternion();
       const Eigen::Vector3d t = fused.pairwise.current_from_previous.translation();
       entry["pairwise_motion"] = {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()};
+    }
+    if (fused.pairwise.rms_mm > 0) {
+      // Also where the motion was refused for it (PairwiseOptions::max_rms_mm).
       entry["pairwise_rms_mm"] = fused.pairwise.rms_mm;
       entry["visual_inliers"] = fused.pairwise.visual_inliers;
     }

@@ -200,6 +200,8 @@ void AddRegistrationOptions(OptionRegistry& r, fusion::FusionOptions* fusion) {
   r.Add("fusion.pairwise.visual_turn_prior_deg", &u.pairwise.visual_turn_prior_deg,
         "visual matches alone: their turn shrinks toward none under this prior per frame, "
         "degrees (0: kept)");
+  r.Add("fusion.pairwise.max_rms_mm", &u.pairwise.max_rms_mm,
+        "a motion whose pairs lie farther from it (RMS, mm) is not used (0: never)");
   r.Add("fusion.pairwise.seed", &u.pairwise.seed, "seed of the RANSAC sampling");
   r.Add("fusion.icp.iterations", &u.icp.iterations, "ICP Gauss-Newton iterations at most");
   r.Add("fusion.icp.max_distance_mm", &u.icp.max_distance_mm,

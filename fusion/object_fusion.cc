@@ -371,6 +371,9 @@ Rigid3 ObjectFusion::Register(const FusionInput& input, bool with_contacts,
     pairwise.min_visual_inliers =
         std::max(pairwise.min_visual_inliers, options_.free_turn_min_visual_inliers);
     pairwise.visual_turn_prior_deg = options_.free_turn_visual_prior_deg;
+    // The correspondences' motion is all that carries the free turn: kept even where its pairs
+    // disagree with it (ICP needs only a start where the surface fixes every direction).
+    pairwise.max_rms_mm = 0;
   }
   result->pairwise = RegisterPair(correspondences, pairwise);
   result->pairwise_ms = MillisecondsSince(pairwise_start);

@@ -23,6 +23,7 @@ void PairwiseOptions::Check() const {
   IHS_CHECK_ARG(min_contacts >= 3, "pairwise.min_contacts must be >= 3");
   IHS_CHECK_ARG(min_contact_spread_mm >= 0, "pairwise.min_contact_spread_mm must be >= 0");
   IHS_CHECK_ARG(visual_turn_prior_deg >= 0, "pairwise.visual_turn_prior_deg must be >= 0");
+  IHS_CHECK_ARG(max_rms_mm >= 0, "pairwise.max_rms_mm must be >= 0");
 }
 
 std::vector<PointMatch>& PairwiseInput::Pairs(const std::string& source, MatchKind kind) {
@@ -247,6 +248,12 @@ PairwiseResult RegisterPair(const PairwiseInput& input, const PairwiseOptions& o
     sum += (result.current_from_previous * from[i] - to[i]).squaredNorm();
   result.rms_mm = std::sqrt(sum / from.size());
   result.visual_inliers = static_cast<int>(visual.size());
+  if (options.max_rms_mm > 0 && result.rms_mm > options.max_rms_mm) {
+    result.reason = "the correspondences disagree with their motion: RMS " +
+                    std::to_string(std::lround(result.rms_mm)) + " mm (at most " +
+                    std::to_string(std::lround(options.max_rms_mm)) + ")";
+    return result;
+  }
   result.contacts = use_contacts ? static_cast<int>(contacts.size()) : 0;
   result.ok = true;
   return result;

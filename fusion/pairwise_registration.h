@@ -74,6 +74,15 @@ struct PairwiseOptions {
   /// label turned the scan by 3-16° in frames where the truth turned by 0-2°, and ICP cannot
   /// undo a turn the surface leaves free (the bottle's spin). 0 keeps every turn as fitted.
   double visual_turn_prior_deg = 1.0;
+  /// A motion whose pairs lie farther from it than this (RMS, mm) is not used: pairs picked as
+  /// one motion within `inlier_mm` that the solve then leaves farther apart are not one motion
+  /// (one fingertip's contacts, γt times each, pulling a handful of feature matches about their
+  /// patch; a turn the prior above held back). On a left hand's box turn such motions (RMS
+  /// 5.4-24 mm, where the others' are 0.3-0.8) moved the box 8-27 mm along its thinnest side in
+  /// frames the truth moved it by 0.5 mm; ICP kept part of it (docs/fusion.md). ObjectFusion
+  /// turns it off where the surface leaves a turn free (the motion is all that carries it).
+  /// 0: never.
+  double max_rms_mm = 5.0;
   /// Seed of the RANSAC sampling (results are deterministic).
   std::uint32_t seed = 1;
 

@@ -104,6 +104,7 @@ TEST(PairwiseRegistrationTest, ContactsTheFeaturesContradictAreDropped) {
   const PairwiseResult checked = RegisterPair(scene.input);
   PairwiseOptions unchecked_options;
   unchecked_options.check_contacts = false;
+  unchecked_options.max_rms_mm = 0;  // Used however far its pairs end from it.
   const PairwiseResult unchecked = RegisterPair(scene.input, unchecked_options);
   ASSERT_TRUE(checked.ok && unchecked.ok);
   const double checked_error = MotionError(checked.current_from_previous, scene.truth);
@@ -181,6 +182,50 @@ TEST(PairwiseRegistrationTest, VisualMatchesAloneKeepOnlyTheTurnTheyFix) {
   EXPECT_LT(kept.visual_turn_deg, 0.3);
   EXPECT_GT(kept.visual_turn_kept, 0.95);
   EXPECT_LT(MotionError(kept.current_from_previous, spread.truth), 0.6);
+}
+
+// Matches that agree with one motion among themselves but whose solve, under the turn prior,
+// leaves them far apart are not a motion: nine matches over a 60 mm patch (a box face's repeated
+// squares matched a square over) turned 60° about the patch; the prior keeps part of the turn
+// and the pairs end centimetres from where it puts them. The frame gets no motion (ICP starts
+// where the object was) and says why; with the check off it is used as fitted.
+TEST(PairwiseRegistrationTest, MatchesItsSolveLeavesFarApartAreNotAMotion) {
+  std::mt19937 rng = test::Rng(4);
+  std::normal_distribution<double> noise(0, 0.5);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const Eigen::Vector3d patch(0, 0, 600);
+  const Rigid3 wrong = Rigid3::Translation(patch) *
+                       Rigid3::FromAxisAngle({0.3, 1, 0.2}, 60 * M_PI / 180) *
+                       Rigid3::Translation(-patch);
+  PairwiseInput input;
+  for (int i = 0; i < 9; ++i) {
+    const Eigen::Vector3d p = patch + Eigen::Vector3d(30 * unit(rng), 30 * unit(rng), 0);
+    input.Pairs("sift", MatchKind::kVisual)
+        .push_back({p, wrong * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng))});
+  }
+  PairwiseOptions unchecked;
+  unchecked.max_rms_mm = 0;
+  const PairwiseResult used = RegisterPair(input, unchecked);
+  ASSERT_TRUE(used.ok) << used.reason;
+  const PairwiseResult refused = RegisterPair(input);
+  std::printf("9 matches turned 60°: %.0f %% of the turn kept, pairs %.1f mm from the motion\n",
+              100 * used.visual_turn_kept, used.rms_mm);
+  EXPECT_GT(used.rms_mm, 5.0);
+  EXPECT_FALSE(refused.ok);
+  EXPECT_EQ(refused.contacts, 0);
+  EXPECT_NEAR(refused.rms_mm, used.rms_mm, 1e-9);
+  EXPECT_NE(refused.reason.find("disagree with their motion"), std::string::npos) << refused.reason;
+
+  // The same patch turned by 2°: the pairs stay close to what the prior keeps, and it is used.
+  PairwiseInput small;
+  const Rigid3 turn = Rigid3::Translation(patch) *
+                      Rigid3::FromAxisAngle({0.3, 1, 0.2}, 2 * M_PI / 180) *
+                      Rigid3::Translation(-patch);
+  for (const PointMatch& m : input.All(MatchKind::kVisual))
+    small.Pairs("sift", MatchKind::kVisual).push_back({m.previous, turn * m.previous});
+  const PairwiseResult kept = RegisterPair(small);
+  ASSERT_TRUE(kept.ok) << kept.reason;
+  EXPECT_LT(kept.rms_mm, 2.0);
 }
 
 // A correspondence source is one more set: its kind decides how it weighs, its name only what
