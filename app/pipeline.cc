@@ -428,11 +428,13 @@ void Pipeline::ExportLoop() {
             {"cleanup", exported.meshes.cleanup_ms},
             {"smoothing", exported.meshes.smoothing_ms},
             {"poisson", exported.meshes.poisson_ms},
-            {"bound", exported.meshes.bound_ms}}},
+            {"bound", exported.meshes.bound_ms},
+            {"repair", exported.meshes.repair_ms}}},
           {"mesh",
            {{"faces", exported.meshes.watertight.faces.size()},
             {"watertight", exported.meshes.IsWatertight()},
             {"self_intersections", exported.meshes.self_intersections},
+            {"self_intersections_repaired", exported.meshes.repaired_intersections},
             {"unseen_share", exported.meshes.unseen_share},
             {"cut_share", exported.meshes.cut_share},
             {"hull_cut_share", exported.meshes.hull_cut_share},
@@ -454,6 +456,12 @@ void Pipeline::ExportLoop() {
       }
       job->record->WriteStats(output_.folder / "stats.json", extra);
       ++s.exports;
+      if (exported.meshes.repaired_intersections > 0) {
+        spdlog::info(
+            "export: the closed mesh crossed itself ({} pairs of faces); re-made from its signed "
+            "distance without them",
+            exported.meshes.repaired_intersections);
+      }
       if (exported.meshes.self_intersections > 0) {
         spdlog::warn(
             "export: the closed mesh crosses itself ({} pairs of faces): closed and manifold, "

@@ -558,6 +558,9 @@ void AddMeshingOptions(OptionRegistry& r, fusion::MeshingOptions* options) {
   r.Add("mesh.bound_box_outlier_share", &m.bound_box_outlier_share,
         "the box leaves out this share of the seen surface's vertices beyond each face (a blob "
         "of hand fused proud of a face is cut back to the face)");
+  r.Add("mesh.repair_self_intersections", &m.repair_self_intersections,
+        "a closed mesh whose faces cross is re-made from its signed distance on the bound's "
+        "lattice");
   r.Add("mesh.color", &m.color, "per-vertex colours in the exported meshes");
 }
 

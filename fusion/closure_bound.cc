@@ -84,16 +84,23 @@ float DistanceSqToTriangle(const Eigen::Vector3f& p, const Eigen::Vector3f& a,
   return (ap - (vb * denominator) * ab - (vc * denominator) * ac).squaredNorm();
 }
 
-// Per lattice point: −1 inside `mesh` (watertight), +1 outside, by the parity of the faces
-// crossed along z below the point.
+// Per lattice point: −1 inside `mesh` (closed, oriented), +1 outside, by the winding number
+// along z below the point: each face crossed facing down counts +1, facing up −1, and a point
+// is inside where the sum is not zero (whichever way the faces are oriented). Without
+// self-intersections that is the parity of the crossings; where parts of the mesh overlap or
+// fold through each other, the inside is their union (parity would hollow out the overlap).
 std::vector<std::int8_t> InsideSign(const TriangleMesh& mesh, const Lattice& lattice) {
-  std::vector<std::vector<float>> crossings(static_cast<size_t>(lattice.size[0]) * lattice.size[1]);
+  // Per column: (height, +1 entering or −1 leaving) of each face crossed.
+  std::vector<std::vector<std::pair<float, int>>> crossings(static_cast<size_t>(lattice.size[0]) *
+                                                            lattice.size[1]);
   for (const auto& face : mesh.faces) {
     Eigen::Vector3d corner[3];
     for (int c = 0; c < 3; ++c) corner[c] = mesh.vertices[face[c]].cast<double>();
     Eigen::Vector2d q[3] = {corner[0].head<2>(), corner[1].head<2>(), corner[2].head<2>()};
     double area = TwiceSignedArea(q);
     if (area == 0) continue;  // Seen edge-on from z: no column crosses it alone.
+    // Counter-clockwise from above: the face's normal points up (a way out going up).
+    const int winding = area > 0 ? -1 : 1;
     if (area < 0) {
       std::swap(q[1], q[2]);
       std::swap(corner[1], corner[2]);
@@ -111,20 +118,23 @@ std::vector<std::int8_t> InsideSign(const TriangleMesh& mesh, const Lattice& lat
         if (!CoversPoint(q, p, w)) continue;
         const double z =
             (w[0] * corner[0].z() + w[1] * corner[1].z() + w[2] * corner[2].z()) / area;
-        crossings[static_cast<size_t>(j) * lattice.size[0] + i].push_back(static_cast<float>(z));
+        crossings[static_cast<size_t>(j) * lattice.size[0] + i].emplace_back(static_cast<float>(z),
+                                                                             winding);
       }
     }
   }
   std::vector<std::int8_t> sign(static_cast<size_t>(lattice.Count()), 1);
   for (int j = 0; j < lattice.size[1]; ++j) {
     for (int i = 0; i < lattice.size[0]; ++i) {
-      std::vector<float>& column = crossings[static_cast<size_t>(j) * lattice.size[0] + i];
+      auto& column = crossings[static_cast<size_t>(j) * lattice.size[0] + i];
       std::sort(column.begin(), column.end());
       size_t below = 0;
+      int winding = 0;
       for (int k = 0; k < lattice.size[2]; ++k) {
         const float z = lattice.Point(i, j, k).z();
-        while (below < column.size() && column[below] < z) ++below;
-        if (below % 2 == 1) sign[lattice.Index(i, j, k)] = -1;
+        for (; below < column.size() && column[below].first < z; ++below)
+          winding += column[below].second;
+        if (winding != 0) sign[lattice.Index(i, j, k)] = -1;
       }
     }
   }
@@ -154,8 +164,12 @@ std::vector<float> SignedDistance(const TriangleMesh& mesh, const Lattice& latti
       }
     }
   }
+  // A point on a face is not zero but a hair to its side: where faces lie inside what the mesh
+  // encloses (overlapping parts), a zero there would start a surface of its own.
+  const float hair = 1e-3f * lattice.step;
   const std::vector<std::int8_t> sign = InsideSign(mesh, lattice);
-  for (size_t n = 0; n < distance.size(); ++n) distance[n] = sign[n] * std::sqrt(distance[n]);
+  for (size_t n = 0; n < distance.size(); ++n)
+    distance[n] = sign[n] * std::max(hair, std::sqrt(distance[n]));
   return distance;
 }
 
@@ -349,6 +363,15 @@ ConvexHull SeenHull(const TriangleMesh& seen, const ClosureBoundOptions& options
 }
 
 }  // namespace
+
+TriangleMesh RemeshClosed(const TriangleMesh& closed, double voxel_mm,
+                          double min_component_fraction) {
+  IHS_CHECK_ARG(voxel_mm > 0, "the lattice's step must be positive, got " << voxel_mm);
+  if (closed.faces.empty()) return closed;
+  const Lattice lattice = LatticeAround(closed, static_cast<float>(voxel_mm));
+  const std::vector<float> field = SignedDistance(closed, lattice, 1.5f * lattice.step);
+  return Remesh(lattice, field, closed, min_component_fraction);
+}
 
 ClosureBound BoundClosure(const TriangleMesh& closed, const TriangleMesh& seen,
                           const FreeSpace& free_space, const ClosureBoundOptions& options) {

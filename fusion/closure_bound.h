@@ -63,6 +63,15 @@ struct ClosureBound {
   HullShape hull_shape = HullShape::kSeen;
 };
 
+/// The surface that bounds what `closed` (closed and oriented, mm) encloses — the points its
+/// faces wind round (a winding number not zero), the union of parts that overlap — as the zero
+/// set of its signed distance on a lattice of step `voxel_mm`, by marching cubes: a closed mesh
+/// that folds through itself (Poisson's, now and then) re-made without crossing faces, its
+/// colours from the nearest vertex of `closed`; pieces under `min_component_fraction` of the
+/// largest dropped.
+TriangleMesh RemeshClosed(const TriangleMesh& closed, double voxel_mm,
+                          double min_component_fraction);
+
 /// `closed` (watertight, object frame, mm) without the space `free_space` saw empty, except
 /// within `options.keep_seen_mm` of the vertices of `seen` (the surface frames saw), and, with
 /// `options.seen_hull`, without what lies outside the convex hull of those vertices (or of their

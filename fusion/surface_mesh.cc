@@ -366,8 +366,19 @@ MeshingResult MakeMeshes(const TriangleMesh& raw, const MeshingOptions& options,
       result.hull_shape = bound.hull_shape;
       result.bound_ms = MillisecondsSince(start);
     }
-    result.unseen_share = UnseenShare(result.watertight, result.smoothed);
     result.self_intersections = FindSelfIntersections(result.watertight, 0).pairs;
+    if (result.self_intersections > 0 && options.repair_self_intersections) {
+      start = SteadyClock::now();
+      TriangleMesh remade =
+          RemeshClosed(result.watertight, options.bound_voxel_mm, options.min_component_fraction);
+      if (remade.IsWatertight() && FindSelfIntersections(remade, 0).pairs == 0) {
+        result.repaired_intersections = result.self_intersections;
+        result.self_intersections = 0;
+        result.watertight = std::move(remade);
+      }
+      result.repair_ms = MillisecondsSince(start);
+    }
+    result.unseen_share = UnseenShare(result.watertight, result.smoothed);
   }
   return result;
 }

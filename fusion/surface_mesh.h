@@ -75,6 +75,10 @@ struct MeshingOptions {
   /// back to the face. On 12 fifth turns of boxes and cubes every side of mesh.ply came closer to
   /// the truth's, 1-4 mm (docs/fusion.md); 0: the box holds every seen vertex.
   double bound_box_outlier_share = 0.005;
+  /// A closed mesh whose faces cross (FindSelfIntersections: Poisson folds through itself now
+  /// and then) is re-made as the zero set of its own signed distance on the bound's lattice
+  /// (RemeshClosed: what it encloses, overlaps joined), and kept when that has no crossings.
+  bool repair_self_intersections = true;
   /// Give the result per-vertex colours from the nearest vertex of the input (when it has them).
   bool color = true;
 
@@ -125,6 +129,9 @@ struct MeshingResult {
   /// Pairs of `watertight`'s faces that cross (FindSelfIntersections): Poisson can fold its
   /// surface through itself, and such a mesh is closed and manifold but not watertight.
   std::int64_t self_intersections = 0;
+  /// Pairs of crossing faces that the closed mesh had before it was re-made without them
+  /// (MeshingOptions::repair_self_intersections; 0: none, or not repaired).
+  std::int64_t repaired_intersections = 0;
   /// `watertight` is closed, edge-manifold, oriented and does not cross itself.
   bool IsWatertight() const { return watertight.IsWatertight() && self_intersections == 0; }
   /// Time spent, ms.
@@ -132,6 +139,7 @@ struct MeshingResult {
   double smoothing_ms = 0;
   double poisson_ms = 0;
   double bound_ms = 0;
+  double repair_ms = 0;
 };
 
 /// Runs the steps above on a raw marching-cubes mesh; Poisson's mesh is bounded by the views of

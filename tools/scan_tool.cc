@@ -110,11 +110,13 @@ nlohmann::json MeshSummary(const ihs::fusion::MeshingResult& meshes, double expo
             {"cleanup", meshes.cleanup_ms},
             {"smoothing", meshes.smoothing_ms},
             {"poisson", meshes.poisson_ms},
-            {"bound", meshes.bound_ms}}},
+            {"bound", meshes.bound_ms},
+            {"repair", meshes.repair_ms}}},
           {"mesh",
            {{"faces", meshes.watertight.faces.size()},
             {"watertight", meshes.IsWatertight()},
             {"self_intersections", meshes.self_intersections},
+            {"self_intersections_repaired", meshes.repaired_intersections},
             {"unseen_share", meshes.unseen_share},
             {"cut_share", meshes.cut_share},
             {"hull_cut_share", meshes.hull_cut_share},
@@ -181,6 +183,12 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
               meshes.IsWatertight()              ? "watertight"
               : meshes.watertight.IsWatertight() ? "closed but crossing itself: NOT watertight"
                                                  : "NOT watertight");
+  if (meshes.repaired_intersections > 0) {
+    std::printf(
+        "repaired: Poisson's mesh crossed itself (%lld pairs of faces); re-made from its "
+        "signed distance without them (%.0f ms)\n",
+        static_cast<long long>(meshes.repaired_intersections), meshes.repair_ms);
+  }
   std::printf(
       "coverage: seen from %.1f %% of the directions around it, %.1f %% of the "
       "watertight mesh never seen\n",

@@ -373,5 +373,38 @@ TEST(ClosureBoundTest, ASeenSurfaceWithoutVolumeHasNoHull) {
   EXPECT_TRUE(ConvexHull::Of({}, 0.25).Empty());
 }
 
+// A closed mesh that crosses itself is re-made without the crossings, enclosing what it
+// enclosed: two overlapping 20 mm cubes as one mesh become their union (parity would have
+// hollowed out the overlap), and a ball whose pole was pushed through its far side becomes the
+// ball with the fold's spike.
+TEST(ClosureBoundTest, AClosedMeshCrossingItselfIsRemadeWithoutTheCrossings) {
+  const TriangleMesh cube = test::MakeCube(20);
+  const TriangleMesh overlapping = test::MergeMeshes(cube, cube, {8, 6, 4});
+  ASSERT_TRUE(overlapping.IsWatertight());
+  ASSERT_GT(FindSelfIntersections(overlapping).pairs, 0);
+  const TriangleMesh joined = RemeshClosed(overlapping, 1.0, 0.05);
+  EXPECT_TRUE(joined.IsWatertight());
+  EXPECT_EQ(FindSelfIntersections(joined).pairs, 0);
+  const double union_volume = 2 * 8000.0 - 12 * 14 * 16;  // 13 312 mm³.
+  std::printf("two overlapping cubes: union %.0f mm³, re-made %.0f mm³\n", union_volume,
+              joined.Volume());
+  EXPECT_NEAR(joined.Volume(), union_volume, 0.03 * union_volume);
+
+  TriangleMesh folded = test::MakeUvSphere(30, 24, 48);
+  int pole = 0;
+  for (int v = 0; v < static_cast<int>(folded.vertices.size()); ++v) {
+    if (folded.vertices[v].z() > folded.vertices[pole].z()) pole = v;
+  }
+  folded.vertices[pole] = {0, 0, -45};
+  ASSERT_TRUE(folded.IsWatertight());
+  ASSERT_GT(FindSelfIntersections(folded).pairs, 0);
+  const TriangleMesh remade = RemeshClosed(folded, 1.0, 0.05);
+  EXPECT_TRUE(IsWatertightWithoutSelfIntersections(remade));
+  // Nearly all of the ball (its top cap is now a cone down through it) and nothing far beyond.
+  const double ball = 4.0 / 3.0 * M_PI * 30 * 30 * 30;
+  EXPECT_GT(remade.Volume(), 0.8 * ball);
+  EXPECT_LT(remade.Volume(), 1.02 * ball);
+}
+
 }  // namespace
 }  // namespace ihs::fusion

@@ -498,6 +498,10 @@ TEST(BenchToolTest, QuickReportHasEveryTableFileAndMethod) {
   }
   EXPECT_TRUE(ours_sphere);
   EXPECT_EQ(f2m_sphere, Open3dAvailable());
+  // Every export checked as the application checks it, and every one passed.
+  EXPECT_NE(report.find("without faces that cross (`core/mesh_intersections.h`). All "),
+            std::string::npos);
+  EXPECT_EQ(report.find(" did not: "), std::string::npos) << report;
   // Ours, 3 baselines, 5 more γt, Open3D's frame to frame and frame to model.
   const int methods = 4 + 5 + (Open3dAvailable() ? 2 : 0);
   EXPECT_EQ(rows, (data.empty() ? 2 : 3) * methods);
@@ -529,6 +533,39 @@ TEST(ReportTest, AFailedMethodIsAFailedCellWithItsReason) {
   EXPECT_NE(md.find("failed"), std::string::npos) << md;
   const std::string csv = test::ReadFileString(dir / "benchmarks" / "results.csv");
   EXPECT_NE(csv.find("open3d-f2m died of signal 6 (Aborted)"), std::string::npos) << csv;
+}
+
+// Each method's mesh.ply went through the export's watertight check: the report counts them
+// and names the ones that failed (results.csv has the crossing pairs).
+TEST(ReportTest, AMeshThatCrossesItselfIsNamed) {
+  const test::TempDir dir;
+  CaseResult session;
+  session.bench_case = {"004-sphere", "sphere", "recorded:x", false, 300, true};
+  auto method = [](const std::string& name, bool watertight, int crossing) {
+    MethodResult m;
+    m.method = name;
+    m.ok = true;
+    m.frames = m.registered = 300;
+    m.measures["watertight"] = watertight;
+    m.measures["self_intersections"] = crossing;
+    m.measures["watertight_faces"] = name == "contacts-only" ? 0 : 5000;
+    return m;
+  };
+  session.methods = {method("ours", true, 0), method("visual-only", false, 4),
+                     method("no-icp", false, 0), method("contacts-only", false, 0)};
+  const std::vector<Method> methods = {
+      {"ours"}, {"visual-only", 0}, {"no-icp", 15, true, false}, {"contacts-only", 15, false}};
+  ReportOptions options;
+  options.out = dir.path();
+  options.mesh_pictures = false;
+  const std::string md = WriteReport({session}, methods, options);
+  EXPECT_NE(md.find("3 of 4 did not: 004-sphere (visual-only, 4 crossing face pairs); 004-sphere "
+                    "(no-icp, open or not manifold); 004-sphere (contacts-only, no closed mesh)."),
+            std::string::npos)
+      << md;
+  const std::string csv = test::ReadFileString(dir / "benchmarks" / "results.csv");
+  EXPECT_NE(csv.find("volume_unseen_share,self_intersections,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("004-sphere,visual-only,1,300,300,"), std::string::npos) << csv;
 }
 
 TEST(ReportTest, AMethodThatLostTheObjectIsReportedAsLost) {
