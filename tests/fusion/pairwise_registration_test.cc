@@ -187,8 +187,9 @@ TEST(PairwiseRegistrationTest, VisualMatchesAloneKeepOnlyTheTurnTheyFix) {
 // Matches that agree with one motion among themselves but whose solve, under the turn prior,
 // leaves them far apart are not a motion: nine matches over a 60 mm patch (a box face's repeated
 // squares matched a square over) turned 60° about the patch; the prior keeps part of the turn
-// and the pairs end centimetres from where it puts them. The frame gets no motion (ICP starts
-// where the object was) and says why; with the check off it is used as fitted.
+// and the pairs end farther from where it puts them than they were picked as one motion by.
+// The frame gets no motion (ICP starts where the object was) and says why; with the check off
+// it is used as fitted.
 TEST(PairwiseRegistrationTest, MatchesItsSolveLeavesFarApartAreNotAMotion) {
   std::mt19937 rng = test::Rng(4);
   std::normal_distribution<double> noise(0, 0.5);
