@@ -49,6 +49,9 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(contact_noise_reference_mm >= 0, "fusion.contact_noise_reference_mm must be >= 0");
   IHS_CHECK_ARG(icp_retry_fraction >= 0 && icp_retry_fraction <= 1,
                 "fusion.icp_retry_fraction must be in [0, 1]");
+  IHS_CHECK_ARG(icp_retry_drop >= 0 && icp_retry_drop <= 1,
+                "fusion.icp_retry_drop must be in [0, 1]");
+  IHS_CHECK_ARG(icp_retry_gain > 0, "fusion.icp_retry_gain must be positive");
 }
 
 ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
@@ -398,15 +401,20 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   // A registration that lands far off (a bad contact, a slipped finger) leaves ICP few pairs;
   // from where the object was, it may find more.
   const double paired = static_cast<double>(result->icp.inliers) / object.points.size();
-  if (result->pairwise.ok && (!result->icp.ok || paired < options_.icp_retry_fraction)) {
+  // Only where the surface fixes every direction: where it leaves a turn free, the object where
+  // it was pairs as many points as where the correspondences turned it.
+  const bool dropped =
+      !turn_carry_.SurfaceLeavesTurnFree() && paired < options_.icp_retry_drop * last_paired_;
+  if (result->pairwise.ok && (!result->icp.ok || paired < options_.icp_retry_fraction || dropped)) {
     IcpResult retry = AlignAt(object, setup, cam_from_object_, {}, result);
-    if (retry.ok && retry.inliers > 1.2 * result->icp.inliers) {
+    if (retry.ok && retry.inliers > options_.icp_retry_gain * result->icp.inliers) {
       result->icp = std::move(retry);
       icp_predicted = cam_from_object_;
       result->icp_from_previous = true;
     }
   }
   if (result->icp.ok) {
+    last_paired_ = static_cast<double>(result->icp.inliers) / object.points.size();
     surface_left_free_ = result->icp.free_directions != 0;
     turn_carry_.ObserveSurface(result->icp.free_directions);
     *pose = result->icp.cam_from_volume;
