@@ -58,8 +58,8 @@ struct FusionOptions {
   /// it is tried again from the previous pose, and that result kept if it pairs
   /// icp_retry_gain times as many.
   double icp_retry_fraction = 0.7;
-  /// It is also tried again where it pairs less than this share of what the last fused frame's
-  /// ICP paired, where the surface fixes every direction (0: never). A start the registration
+  /// It is also tried again where it pairs less than this share of what the last frame's ICP
+  /// paired, where the surface fixes every direction (0: never). A start the registration
   /// put beside the object (a few fingertips or features moving together, wrongly) can hold ICP
   /// in a minimum that pairs markedly fewer points than the frames around it, yet more than the
   /// absolute share above: on a left-handed box turn, 8.7 mm along a face in one frame with
@@ -381,7 +381,7 @@ class ObjectFusion {
   std::vector<std::uint16_t> near_depth_;
   bool started_ = false;
   Rigid3 cam_from_object_;
-  // The share of its points the last fused frame's ICP paired (0: none yet).
+  // The share of its points the last frame's ICP paired (0: none yet).
   double last_paired_ = 0;
   // The object's motion between the last two fused frames (camera frame).
   Rigid3 last_step_;
