@@ -224,7 +224,12 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   Integrate(input, object, pose, &result);
   if (options_.anchor_contacts) UpdateAnchors(contacts, pose, &anchors_);
   UpdateFeatureAnchors(input.correspondences, pose);
-  if (result.icp.ok) pivot_in_object_ = pose.Inverse() * result.icp.pivot;
+  // Only where ICP judged the free directions: there it took the turns about where the model's
+  // normal lines meet (a ball's centre, a bottle's axis); where anchors joined every direction,
+  // about the points' centroid, which a turn carried about moves the surface off itself.
+  if (result.icp.ok && result.icp.free_directions >= 0) {
+    pivot_in_object_ = pose.Inverse() * result.icp.pivot;
+  }
   turn_carry_.Learn(result.ContactsUsed(), result.ContactsUsed() || result.pairwise.ok);
   CatchUpTurn(&result);
   return finish(FusionStatus::kFused);

@@ -387,7 +387,8 @@ class ObjectFusion {
   Rigid3 last_step_;
   // Whether the last frame's ICP left a direction free (FusionOptions::predict_moving).
   bool surface_left_free_ = true;
-  // Where the last fused frame's ICP took its turns about, in the object frame.
+  // Where the last fused frame whose ICP judged the free directions took its turns about (the
+  // turn the hand carries is turned about it), in the object frame.
   Eigen::Vector3d pivot_in_object_ = Eigen::Vector3d::Zero();
   // The running estimate of the contacts' disagreement with the registered motion, mm (starts
   // at the reference: the configured share until contacts have been seen).
