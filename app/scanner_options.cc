@@ -391,8 +391,8 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
   r.Add("fusion.icp_retry_fraction", &u.icp_retry_fraction,
         "ICP is retried from the previous pose when it pairs fewer than this share of points");
   r.Add("fusion.icp_retry_drop", &u.icp_retry_drop,
-        "... and when it pairs less than this share of what the last frame's ICP paired (0: "
-        "never)");
+        "... and when it pairs less than this share of what the last frame's ICP paired, "
+        "where the surface fixes every direction (0: never)");
   r.Add("fusion.icp_retry_gain", &u.icp_retry_gain,
         "... the retry kept where it pairs this many times the first's points");
   r.Add("fusion.predict_moving", &u.predict_moving,
