@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -116,7 +117,17 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["colour_moved_mm"] = fused.colour.moved_mm;
       entry["colour_turn_deg"] = fused.colour.turn_deg;
       entry["colour_uncertainty_mm"] = fused.colour.uncertainty_mm;
+      entry["colour_correlation"] = fused.colour.correlation;
+      if (std::isfinite(fused.colour_still_correlation)) {
+        entry["colour_still_correlation"] = fused.colour_still_correlation;
+      }
+      if (fused.colour_kept_still) {
+        entry["colour_kept_still"] = true;
+        ++colour_still_frames_;
+      }
       ++colour_frames_;
+    } else if (!fused.colour.reason.empty() && fused.colour.reason != "no free direction") {
+      entry["colour_skipped"] = fused.colour.reason;
     }
     if (fused.hand_carried_deg > 0) {
       entry["hand_carried_deg"] = fused.hand_carried_deg;
@@ -200,6 +211,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"keypoint_alias_deg", keypoint_alias_deg_},
                             {"loop_corrections", loop_corrections_},
                             {"colour_aligned_frames", colour_frames_},
+                            {"colour_still_frames", colour_still_frames_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},
                             {"hand_undecided_frames", hand_undecided_frames_},

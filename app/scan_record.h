@@ -83,6 +83,7 @@ class ScanRecord {
   std::int64_t loop_corrections_ = 0;
   // Frames the colour alignment moved (colour_align.h).
   std::int64_t colour_frames_ = 0;
+  std::int64_t colour_still_frames_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;
   std::int64_t hand_back_frames_ = 0;

@@ -395,6 +395,11 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "where the surface fixes every direction (0: never)");
   r.Add("fusion.icp_retry_gain", &u.icp_retry_gain,
         "... the retry kept where it pairs this many times the first's points");
+  r.Add("fusion.colour_weighs_still", &u.colour_weighs_still,
+        "where the surface leaves a turn free and the object shows a pattern, ICP and the "
+        "colours also from the previous pose, kept where the colours match better");
+  r.Add("fusion.colour_still_margin", &u.colour_still_margin,
+        "... by more than this much correlation");
   r.Add("fusion.predict_moving", &u.predict_moving,
         "where nothing registers a frame, the object moves on as in the last frame (when the "
         "surface left no direction free there; off by default)");

@@ -299,11 +299,7 @@ class ColourProblem {
   // Fits the gain and offset (model ≈ gain·frame + offset) and the residuals' scale at
   // `correction`; false where too few points pair or the frame shows no pattern.
   bool Calibrate(const Rigid3& correction) {
-    std::vector<std::pair<double, double>> pairs;  // (frame, model)
-    for (const ColourPoint& point : points_) {
-      ModelSample sample;
-      if (Pair(correction * point.point, &sample)) pairs.emplace_back(point.grey, sample.grey);
-    }
+    const std::vector<std::pair<double, double>> pairs = Greys(correction);
     if (static_cast<int>(pairs.size()) < options_.min_points) return false;
     double mf = 0, mm = 0;
     for (const auto& [f, m] : pairs) mf += f, mm += m;
@@ -361,7 +357,31 @@ class ColourProblem {
 
   double sigma() const { return sigma_; }
 
+  // How alike the frame's grey and the model's are at `correction`: their correlation over the
+  // points that pair (0 where fewer than `min_points` do or either is flat).
+  double Correlation(const Rigid3& correction) const {
+    const std::vector<std::pair<double, double>> pairs = Greys(correction);
+    if (static_cast<int>(pairs.size()) < options_.min_points) return 0;
+    double mf = 0, mm = 0;
+    for (const auto& [f, m] : pairs) mf += f, mm += m;
+    mf /= pairs.size(), mm /= pairs.size();
+    double ff = 0, mm2 = 0, fm = 0;
+    for (const auto& [f, m] : pairs)
+      ff += (f - mf) * (f - mf), mm2 += (m - mm) * (m - mm), fm += (f - mf) * (m - mm);
+    return ff > 0 && mm2 > 0 ? fm / std::sqrt(ff * mm2) : 0;
+  }
+
  private:
+  // The (frame, model) greys of the points that pair at `correction`.
+  std::vector<std::pair<double, double>> Greys(const Rigid3& correction) const {
+    std::vector<std::pair<double, double>> pairs;
+    for (const ColourPoint& point : points_) {
+      ModelSample sample;
+      if (Pair(correction * point.point, &sample)) pairs.emplace_back(point.grey, sample.grey);
+    }
+    return pairs;
+  }
+
   static double Huber(double residual, double threshold) {
     const double a = std::abs(residual);
     return a <= threshold ? 0.5 * a * a : threshold * (a - 0.5 * threshold);
@@ -505,6 +525,7 @@ std::vector<double> FitBlurs(const GreyPatch& frame_grey, const GreyPatch& model
     result->sigma = problem.sigma();
     if (blur == options.fine_blur_px) {
       information = ProfileInformation(problem, directions, centre, *current, options);
+      result->correlation = problem.Correlation(*current);
     }
   }
   return information;

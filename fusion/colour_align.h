@@ -111,6 +111,9 @@ struct ColourAlignResult {
   /// Points compared in the last iteration, and their residuals' robust scale (grey levels).
   int points = 0;
   double sigma = 0;
+  /// The correlation of the frame's grey with the model's where they pair, at the fitted
+  /// motion (on the fine blur; 0 where it did not get that far).
+  double correlation = 0;
 };
 
 /// Refines `correction` (predicted_from_current, ICP's) along `free` (about `centre`, in the

@@ -52,6 +52,8 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(icp_retry_drop >= 0 && icp_retry_drop <= 1,
                 "fusion.icp_retry_drop must be in [0, 1]");
   IHS_CHECK_ARG(icp_retry_gain > 0, "fusion.icp_retry_gain must be positive");
+  IHS_CHECK_ARG(std::isfinite(colour_still_margin),
+                "fusion.colour_still_margin must be a finite number");
 }
 
 ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
@@ -419,11 +421,12 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     }
   }
   if (result->icp.ok) {
+    *pose = result->icp.cam_from_volume;
+    AlignColours(object, icp_predicted, pose, result);
+    WeighStillByColour(object, setup, icp_predicted, pose, result);
     last_paired_ = static_cast<double>(result->icp.inliers) / object.points.size();
     surface_left_free_ = result->icp.free_directions != 0;
     turn_carry_.ObserveSurface(result->icp.free_directions);
-    *pose = result->icp.cam_from_volume;
-    AlignColours(object, icp_predicted, pose, result);
     return true;
   }
   return result->pairwise.ok;
@@ -517,21 +520,59 @@ void ObjectFusion::AlignColours(const ObjectPixels& object, const Rigid3& icp_pr
                                 Rigid3* pose, FusionResult* result) const {
   if (!options_.colour.enabled || result->icp.free.empty()) return;
   const auto start = SteadyClock::now();
+  result->colour = AlignColoursOf(object, result->icp, icp_predicted, pose);
+  result->colour_ms += MillisecondsSince(start);
+}
+
+ColourAlignResult ObjectFusion::AlignColoursOf(const ObjectPixels& object, const IcpResult& icp,
+                                               const Rigid3& icp_predicted, Rigid3* pose) const {
   // ICP's correction takes the frame's points to where model_image_ sees them.
   const Rigid3 correction = model_image_pose_ * pose->Inverse();
   // The free directions are in the camera frame of ICP's prediction; model_image_ may have been
   // cast from another (a retry from the previous pose that was not kept).
   const Rigid3 to_image = model_image_pose_ * icp_predicted.Inverse();
-  std::vector<FreeDirection> free = result->icp.free;
+  std::vector<FreeDirection> free = icp.free;
   for (FreeDirection& direction : free) {
     direction.turn = to_image.rotation() * direction.turn;
     direction.shift = to_image.rotation() * direction.shift;
   }
-  result->colour =
+  ColourAlignResult colour =
       AlignColour(object.frame, object.mask, object.box, model_image_, intrinsics_, correction,
-                  free, to_image * result->icp.free_centre, options_.colour);
-  if (result->colour.applied) *pose = result->colour.correction.Inverse() * model_image_pose_;
-  result->colour_ms = MillisecondsSince(start);
+                  free, to_image * icp.free_centre, options_.colour);
+  if (colour.applied) *pose = colour.correction.Inverse() * model_image_pose_;
+  return colour;
+}
+
+void ObjectFusion::WeighStillByColour(const ObjectPixels& object, const IcpSetup& setup,
+                                      const Rigid3& icp_predicted, Rigid3* pose,
+                                      FusionResult* result) {
+  // Only where the object shows a pattern (whether or not the colours could align it from the
+  // registered pose: a turn far off leaves them no basin) and the registration moved it. ICP
+  // from the previous pose, without the contacts: where they held it, its free directions are
+  // those of the registration's ICP less what the contacts joined.
+  const Rigid3 moved = icp_predicted * cam_from_object_.Inverse();
+  if (!options_.colour_weighs_still ||
+      !(result->colour.pattern_spread >= options_.colour.min_grey_spread) ||
+      !turn_carry_.SurfaceLeavesTurnFree() ||
+      (moved.translation().norm() < 1e-6 && Eigen::AngleAxisd(moved.rotation()).angle() < 1e-9)) {
+    return;
+  }
+  IcpResult icp = AlignAt(object, setup, cam_from_object_, {}, result);
+  if (!icp.ok || icp.free.empty()) return;
+  const auto start = SteadyClock::now();
+  Rigid3 still = icp.cam_from_volume;
+  ColourAlignResult colour = AlignColoursOf(object, icp, cam_from_object_, &still);
+  result->colour_ms += MillisecondsSince(start);
+  // Where it stood the colours may have nothing to better (applied false): their correlation
+  // is measured all the same, wherever they paired.
+  if (!(colour.correlation > 0)) return;
+  result->colour_still_correlation = colour.correlation;
+  if (colour.correlation > result->colour.correlation + options_.colour_still_margin) {
+    result->icp = std::move(icp);
+    result->colour = std::move(colour);
+    result->colour_kept_still = true;
+    *pose = still;
+  }
 }
 
 std::string ObjectFusion::ImplausibleJump(const Rigid3& pose, const Rigid3& step) const {

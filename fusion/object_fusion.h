@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -72,6 +73,16 @@ struct FusionOptions {
   /// with the drop rule at 0.95, more of the box turns developed on held, but a held-out cube
   /// turn broke: docs/fusion.md).
   double icp_retry_gain = 1.2;
+  /// Where the surface leaves a turn free and the object shows a pattern (a patterned or
+  /// labelled ball, bottle or pin: ColourAlignOptions::min_grey_spread), the turn the
+  /// correspondences or the hand gave the frame in those free directions is weighed against the
+  /// object standing still: ICP (without the contacts, which may be what turned it) and the
+  /// colours once more from the previous pose, and that kept where its colours match the
+  /// model's better (their correlation, ColourAlignResult::correlation, higher by more than
+  /// `colour_still_margin`). Fingertips lifted off to re-grasp and still taken for contacts
+  /// turn a ball that stands still; the colours, which see its pattern stand, tell.
+  bool colour_weighs_still = true;
+  double colour_still_margin = 0.0;
   /// Where the pairwise registration has nothing (no features, no contacts), whether the
   /// object is predicted to move on as between the last two fused frames (constant velocity)
   /// rather than to stand still — only when the last frame's ICP left no direction free (where
@@ -240,6 +251,10 @@ struct FusionResult {
   /// Whether ICP started from the previous pose won over the registration's (see
   /// FusionOptions::icp_retry_fraction).
   bool icp_from_previous = false;
+  /// Where the colours weighed the object standing still (FusionOptions::colour_weighs_still):
+  /// their correlation there (else NaN), and whether it won.
+  double colour_still_correlation = std::numeric_limits<double>::quiet_NaN();
+  bool colour_kept_still = false;
   /// Time spent, ms: in all, and on the pairwise solve, the model's raycast, ICP and the
   /// integration.
   double milliseconds = 0;
@@ -337,6 +352,12 @@ class ObjectFusion {
   // object's colours land on the model's (model_image_; FusionOptions::colour).
   void AlignColours(const ObjectPixels& object, const Rigid3& icp_predicted, Rigid3* pose,
                     FusionResult* result) const;
+  ColourAlignResult AlignColoursOf(const ObjectPixels& object, const IcpResult& icp,
+                                   const Rigid3& icp_predicted, Rigid3* pose) const;
+  // ICP and the colours from the previous pose, kept where the colours match better
+  // (FusionOptions::colour_weighs_still).
+  void WeighStillByColour(const ObjectPixels& object, const IcpSetup& setup,
+                          const Rigid3& icp_predicted, Rigid3* pose, FusionResult* result);
   // Why the step from the previous pose to `pose` is implausible (empty when it is not).
   std::string ImplausibleJump(const Rigid3& pose, const Rigid3& step) const;
   // Updates the running estimate of the contacts' noise from how far `step` leaves them.

@@ -1,7 +1,8 @@
 // The colour alignment after ICP: a ball's model fused with its colours from views all around;
 // a new view predicted turned about the ball's centre (a turn its surface leaves free, so ICP
 // keeps it). With a pattern on the ball, the colours find the turn; without one (a uniform,
-// shaded ball) nothing moves.
+// shaded ball) nothing moves. In a scan, they also tell a ball that stands still from the turn
+// that fingertips lifted off it give the frame (FusionOptions::colour_weighs_still).
 
 #include "fusion/colour_align.h"
 
@@ -194,6 +195,82 @@ TEST(ColourAlignTest, APatternedBallTurnedWithNothingElseToRegisterItFollowsByIt
   // Measured: 1.42° off after 178°.
   EXPECT_LT(TurnedBallEndError(true), 3.0);
   EXPECT_GT(TurnedBallEndError(false), 90.0) << "the surface alone kept the turn: no test";
+}
+
+// A patterned ball shown still for 10 frames, then for 30 more either held still while the
+// hand's fingertips, lifted off to re-grasp and still taken for contacts, turn back with the
+// hand `false_deg` a frame (`held` false), or turned 3° a frame by a hand whose contacts hold
+// it (`held` true): the end's turn error, and the frames the colours kept the ball still.
+struct StillRun {
+  double end_deg = 0;
+  int kept_still = 0;
+};
+
+StillRun BallWithContacts(bool weigh_still, bool held, double false_deg) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  std::mt19937 rng(17);
+  FusionOptions options;
+  options.colour_weighs_still = weigh_still;
+  ObjectFusion fusion(intrinsics, options);
+  const Eigen::Vector3d centre(-5, 10, 500);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.1, 1, -0.2).normalized();
+  auto turned = [&](double degrees) {
+    return Rigid3::Translation(centre) * Rigid3::FromAxisAngle(axis, degrees * M_PI / 180);
+  };
+  // Where three fingertips touch the ball (object frame), on its camera side.
+  const std::vector<Eigen::Vector3d> touched = {
+      {kRadius, 0, -10}, {-kRadius * 0.7, 5, -kRadius * 0.7}, {0, -kRadius * 0.8, -20}};
+  double object_deg = 0, hand_deg = 0;
+  StillRun run;
+  Rigid3 first, last;
+  for (int i = 0; i < 40; ++i) {
+    const double before_hand = hand_deg;
+    if (i >= 10) {
+      hand_deg += held ? 3.0 : -false_deg;
+      if (held) object_deg += 3.0;
+    }
+    const Frame frame = Ball(intrinsics, turned(object_deg), /*patterned=*/true, rng);
+    std::vector<std::uint8_t> mask(frame.depth_mm.size());
+    for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+    FusionInput input{&frame, &mask, {}};
+    if (i >= 10) {
+      for (const Eigen::Vector3d& q : touched) {
+        input.correspondences.Pairs("contacts", MatchKind::kContact)
+            .push_back({turned(before_hand) * q, turned(hand_deg) * q});
+      }
+    }
+    const FusionResult result = fusion.Fuse(input);
+    EXPECT_NE(result.status, FusionStatus::kSkipped) << "frame " << i << ": " << result.reason;
+    run.kept_still += result.colour_kept_still;
+    (i == 0 ? first : last) = result.cam_from_object;
+  }
+  const Rigid3 expected = turned(object_deg) * turned(0).Inverse() * first;
+  run.end_deg = TurnDeg(last, expected);
+  std::printf(
+      "patterned ball %s, contacts turning %.0f° a frame, colours weighing it still %s: "
+      "%.2f° off at the end, kept still in %d frames\n",
+      held ? "held and turned" : "standing still", held ? 3.0 : -false_deg,
+      weigh_still ? "on" : "off", run.end_deg, run.kept_still);
+  return run;
+}
+
+TEST(ColourAlignTest, ABallStandingStillIsNotTurnedByFingertipsLiftedOffIt) {
+  // Measured: off 178.9° / 89.9° off at the end (at 3° a frame the colours alone hold it), on
+  // 0.31° / 0.34°, kept still in 28 of the 30 frames.
+  for (const double false_deg : {6.0, 9.0}) {
+    const StillRun off = BallWithContacts(false, /*held=*/false, false_deg);
+    const StillRun on = BallWithContacts(true, /*held=*/false, false_deg);
+    EXPECT_GT(off.end_deg, 10.0) << "the colours alone held it: no test";
+    EXPECT_LT(on.end_deg, 2.0);
+    EXPECT_GT(on.kept_still, 20);
+  }
+}
+
+TEST(ColourAlignTest, ABallTurnedByTheHandsContactsIsNotKeptStill) {
+  // Measured: 0.60° off after 90°, never kept still.
+  const StillRun on = BallWithContacts(true, /*held=*/true, 0);
+  EXPECT_LT(on.end_deg, 2.0);
+  EXPECT_LT(on.kept_still, 3);
 }
 
 TEST(ColourAlignTest, WithoutFreeDirectionsOrColourNothingRuns) {
