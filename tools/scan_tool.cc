@@ -165,6 +165,12 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
         carried, back, undecided,
         summary.contains("hand_caught_up_deg") ? summary["hand_caught_up_deg"].get<double>() : 0.0);
   }
+  if (const int aligned = count(summary, "colour_aligned_frames"); aligned > 0) {
+    std::printf(
+        "  the colours aligned %d frames along the turns the surface leaves free; in %d they "
+        "kept the object standing still against the turn the registration gave it\n",
+        aligned, count(summary, "colour_still_frames"));
+  }
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
   std::printf(
