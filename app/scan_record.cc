@@ -118,16 +118,17 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["colour_turn_deg"] = fused.colour.turn_deg;
       entry["colour_uncertainty_mm"] = fused.colour.uncertainty_mm;
       entry["colour_correlation"] = fused.colour.correlation;
-      if (std::isfinite(fused.colour_still_correlation)) {
-        entry["colour_still_correlation"] = fused.colour_still_correlation;
-      }
-      if (fused.colour_kept_still) {
-        entry["colour_kept_still"] = true;
-        ++colour_still_frames_;
-      }
       ++colour_frames_;
     } else if (!fused.colour.reason.empty() && fused.colour.reason != "no free direction") {
       entry["colour_skipped"] = fused.colour.reason;
+    }
+    // The still pose may win where its colours had nothing to better (not applied).
+    if (std::isfinite(fused.colour_still_correlation)) {
+      entry["colour_still_correlation"] = fused.colour_still_correlation;
+    }
+    if (fused.colour_kept_still) {
+      entry["colour_kept_still"] = true;
+      ++colour_still_frames_;
     }
     if (fused.hand_carried_deg > 0) {
       entry["hand_carried_deg"] = fused.hand_carried_deg;
