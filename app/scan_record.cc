@@ -119,7 +119,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["colour_uncertainty_mm"] = fused.colour.uncertainty_mm;
       entry["colour_correlation"] = fused.colour.correlation;
       ++colour_frames_;
-    } else if (!fused.colour.reason.empty() && fused.colour.reason != "no free direction") {
+    } else if (!fused.colour.reason.empty()) {
       entry["colour_skipped"] = fused.colour.reason;
     }
     // The still pose may win where its colours had nothing to better (not applied).

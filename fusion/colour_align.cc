@@ -301,15 +301,10 @@ class ColourProblem {
   bool Calibrate(const Rigid3& correction) {
     const std::vector<std::pair<double, double>> pairs = Greys(correction);
     if (static_cast<int>(pairs.size()) < options_.min_points) return false;
-    double mf = 0, mm = 0;
-    for (const auto& [f, m] : pairs) mf += f, mm += m;
-    mf /= pairs.size(), mm /= pairs.size();
-    double ff = 0, fm = 0;
-    for (const auto& [f, m] : pairs) ff += (f - mf) * (f - mf), fm += (f - mf) * (m - mm);
-    const double spread = std::sqrt(ff / pairs.size());
-    if (!(spread > 0) || fm <= 0) return false;
-    gain_ = fm / ff;
-    offset_ = mm - gain_ * mf;
+    const Moments moments = MomentsOf(pairs);
+    if (!(moments.ff > 0) || moments.fm <= 0) return false;
+    gain_ = moments.fm / moments.ff;
+    offset_ = moments.mean_model - gain_ * moments.mean_frame;
     std::vector<double> residuals;
     for (const auto& [f, m] : pairs) residuals.push_back(std::abs(m - gain_ * f - offset_));
     std::nth_element(residuals.begin(), residuals.begin() + residuals.size() / 2, residuals.end());
@@ -362,16 +357,27 @@ class ColourProblem {
   double Correlation(const Rigid3& correction) const {
     const std::vector<std::pair<double, double>> pairs = Greys(correction);
     if (static_cast<int>(pairs.size()) < options_.min_points) return 0;
-    double mf = 0, mm = 0;
-    for (const auto& [f, m] : pairs) mf += f, mm += m;
-    mf /= pairs.size(), mm /= pairs.size();
-    double ff = 0, mm2 = 0, fm = 0;
-    for (const auto& [f, m] : pairs)
-      ff += (f - mf) * (f - mf), mm2 += (m - mm) * (m - mm), fm += (f - mf) * (m - mm);
-    return ff > 0 && mm2 > 0 ? fm / std::sqrt(ff * mm2) : 0;
+    const Moments moments = MomentsOf(pairs);
+    return moments.ff > 0 && moments.mm > 0 ? moments.fm / std::sqrt(moments.ff * moments.mm) : 0;
   }
 
  private:
+  // The means of (frame, model) greys and their summed central second moments.
+  struct Moments {
+    double mean_frame = 0, mean_model = 0;
+    double ff = 0, mm = 0, fm = 0;
+  };
+  static Moments MomentsOf(const std::vector<std::pair<double, double>>& pairs) {
+    Moments s;
+    for (const auto& [f, m] : pairs) s.mean_frame += f, s.mean_model += m;
+    s.mean_frame /= pairs.size(), s.mean_model /= pairs.size();
+    for (const auto& [f, m] : pairs) {
+      const double df = f - s.mean_frame, dm = m - s.mean_model;
+      s.ff += df * df, s.mm += dm * dm, s.fm += df * dm;
+    }
+    return s;
+  }
+
   // The (frame, model) greys of the points that pair at `correction`.
   std::vector<std::pair<double, double>> Greys(const Rigid3& correction) const {
     std::vector<std::pair<double, double>> pairs;

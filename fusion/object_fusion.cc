@@ -548,8 +548,8 @@ void ObjectFusion::WeighStillByColour(const ObjectPixels& object, const IcpSetup
                                       FusionResult* result) {
   // Only where the object shows a pattern (whether or not the colours could align it from the
   // registered pose: a turn far off leaves them no basin) and the registration moved it. ICP
-  // from the previous pose, without the contacts: where they held it, its free directions are
-  // those of the registration's ICP less what the contacts joined.
+  // from the previous pose runs without the contacts, so it leaves free every direction the
+  // surface leaves free.
   const Rigid3 moved = icp_predicted * cam_from_object_.Inverse();
   if (!options_.colour_weighs_still ||
       !(result->colour.pattern_spread >= options_.colour.min_grey_spread) ||
