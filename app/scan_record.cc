@@ -146,6 +146,10 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["visual_inliers"] = fused.pairwise.visual_inliers;
     }
     if (fused.icp_from_previous) entry["icp_from_previous"] = true;
+    if (fused.hidden && fused.status != fusion::FusionStatus::kSkipped) {
+      entry["hidden"] = true;
+      ++hidden_frames_;
+    }
     if (fused.keyframe) entry["keyframe"] = true, ++keyframes_;
     if (fused.loops > 0) entry["loops"] = fused.loops, loops_ += fused.loops;
     if (fused.feature_loops > 0) {
@@ -213,6 +217,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"loop_corrections", loop_corrections_},
                             {"colour_aligned_frames", colour_frames_},
                             {"colour_still_frames", colour_still_frames_},
+                            {"hidden_frames", hidden_frames_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},
                             {"hand_undecided_frames", hand_undecided_frames_},

@@ -84,6 +84,8 @@ class ScanRecord {
   // Frames the colour alignment moved (colour_align.h).
   std::int64_t colour_frames_ = 0;
   std::int64_t colour_still_frames_ = 0;
+  // Frames that showed the object mostly hidden: tracked, not integrated (fusion/hidden_span.h).
+  std::int64_t hidden_frames_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).
   std::int64_t hand_carried_frames_ = 0;
   std::int64_t hand_back_frames_ = 0;

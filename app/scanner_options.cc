@@ -400,6 +400,15 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "colours also from the previous pose, kept where the colours match better");
   r.Add("fusion.colour_still_margin", &u.colour_still_margin,
         "... by more than this much correlation");
+  r.Add("fusion.hidden.share", &u.hidden.share,
+        "a frame with fewer than this share of the most object points of the recent frames in "
+        "view shows the object hidden: tracked, not integrated (0: never)");
+  r.Add("fusion.hidden.reference_frames", &u.hidden.reference_frames,
+        "... over this many recent frames in view");
+  r.Add("fusion.hidden.covered_share", &u.hidden.covered_share,
+        "... and where this share of the pixels the model covers at the frame's pose show "
+        "something nearer");
+  r.Add("fusion.hidden.cover_margin_mm", &u.hidden.cover_margin_mm, "... nearer by this much, mm");
   r.Add("fusion.predict_moving", &u.predict_moving,
         "where nothing registers a frame, the object moves on as in the last frame (when the "
         "surface left no direction free there; off by default)");

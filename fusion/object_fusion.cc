@@ -34,6 +34,7 @@ void FusionOptions::Check() const {
   loop_closure.Check();
   colour.Check();
   silhouette.Check();
+  hidden.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -64,6 +65,7 @@ ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions opt
       free_space_(intrinsics, options_.free_space),
       contact_noise_mm_(options_.contact_noise_reference_mm),
       turn_carry_(options_.turn_carry),
+      hidden_(options_.hidden),
       keyframes_(intrinsics, options_.loop_closure, options_.icp) {}
 
 FusionResult ObjectFusion::Skip(std::string reason) const {
@@ -185,6 +187,11 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     return Finish(input, started_at, status, std::move(reason), &result);
   };
   const ObjectPixels object = FindObject(*input.frame, *input.object_mask);
+  // Only where the surface fixes every direction (a box): elsewhere the model's shape does not
+  // show a wrong turn about the free axis, and holding frames out lost more of it (small
+  // bottles).
+  result.hidden = hidden_.Observe(static_cast<int>(object.points.size())) &&
+                  !turn_carry_.SurfaceLeavesTurnFree();
   if (static_cast<int>(object.points.size()) < options_.min_object_points) {
     return finish(FusionStatus::kSkipped,
                   "too few object points: " + std::to_string(object.points.size()) + " (need " +
@@ -223,7 +230,16 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     return finish(FusionStatus::kSkipped, std::move(jump));
   }
   UpdateContactNoise(contacts, step, &result);
-  Integrate(input, object, pose, &result);
+  if (result.hidden && options_.hidden.covered_share > 0) {
+    result.hidden = CoveredByNearer(object, pose);
+  }
+  if (result.hidden) {
+    // Tracked, not integrated: a few hundred points registered from a patch may be turned far
+    // off, and would write that turn into the model.
+    Follow(pose, &result);
+  } else {
+    Integrate(input, object, pose, &result);
+  }
   if (options_.anchor_contacts) UpdateAnchors(contacts, pose, &anchors_);
   UpdateFeatureAnchors(input.correspondences, pose);
   // Only where ICP judged the free directions: there it took the turns about where the model's
@@ -259,7 +275,9 @@ FusionResult ObjectFusion::Finish(const FusionInput& input, SteadyClock::time_po
   }
   // The object frame's origin is the first frame's object points' centroid: within a few cm
   // of the object's centre, a few degrees of the direction to a camera half a metre away.
-  if (status != FusionStatus::kSkipped) coverage_.Observe(result->cam_from_object, {0, 0, 0});
+  if (status != FusionStatus::kSkipped && !result->hidden) {
+    coverage_.Observe(result->cam_from_object, {0, 0, 0});
+  }
   result->coverage = coverage_.Share();
   result->milliseconds = MillisecondsSince(started_at);
   return std::move(*result);
@@ -294,11 +312,15 @@ void ObjectFusion::Start(const FusionInput& input, const ObjectPixels& object,
   started_ = true;
 }
 
-void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& object,
-                             const Rigid3& pose, FusionResult* result) {
+void ObjectFusion::Follow(const Rigid3& pose, FusionResult* result) {
   if (started_) last_step_ = pose * cam_from_object_.Inverse();
   cam_from_object_ = pose;
   result->cam_from_object = pose;
+}
+
+void ObjectFusion::Integrate(const FusionInput& input, const ObjectPixels& object,
+                             const Rigid3& pose, FusionResult* result) {
+  Follow(pose, result);
   const auto integrate_start = SteadyClock::now();
   result->integrated_voxels = volume_.Integrate(object.frame, object.mask, intrinsics_, pose);
   result->integrate_ms = MillisecondsSince(integrate_start);
@@ -426,10 +448,32 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     WeighStillByColour(object, setup, icp_predicted, pose, result);
     last_paired_ = static_cast<double>(result->icp.inliers) / object.points.size();
     surface_left_free_ = result->icp.free_directions != 0;
-    turn_carry_.ObserveSurface(result->icp.free_directions);
+    // A patch of the object says little of what its surface leaves free.
+    if (!result->hidden) turn_carry_.ObserveSurface(result->icp.free_directions);
     return true;
   }
   return result->pairwise.ok;
+}
+
+bool ObjectFusion::CoveredByNearer(const ObjectPixels& object, const Rigid3& pose) {
+  // The whole image: rays are followed only through the box of observed voxels.
+  volume_.Raycast(intrinsics_, pose, {0, 0, 0, 0}, nullptr, 0, &hidden_image_);
+  const auto [u0, v0, u1, v1] = hidden_image_.written;
+  int seen = 0, covered = 0;
+  for (int v = v0; v < v1; ++v) {
+    for (int u = u0; u < u1; ++u) {
+      const int pixel = v * hidden_image_.width + u;
+      const float model = hidden_image_.depth_mm[pixel];
+      if (!(model > 0)) continue;
+      const std::uint16_t depth = object.frame.depth_mm[pixel];
+      if (object.mask[pixel]) {
+        ++seen;
+      } else if (depth > 0 && depth < model - options_.hidden.cover_margin_mm) {
+        ++covered;
+      }
+    }
+  }
+  return covered > 0 && covered >= options_.hidden.covered_share * (seen + covered);
 }
 
 bool ObjectFusion::ContactsSpread(const FusionResult& result) const {

@@ -20,6 +20,7 @@
 #include "core/triangle_mesh.h"
 #include "fusion/colour_align.h"
 #include "fusion/free_space.h"
+#include "fusion/hidden_span.h"
 #include "fusion/icp.h"
 #include "fusion/keyframe_graph.h"
 #include "fusion/model_contacts.h"
@@ -53,6 +54,9 @@ struct FusionOptions {
   /// ICP's silhouette term: the frame's outline against the background held to the model's
   /// edge (silhouette.h).
   SilhouetteOptions silhouette;
+  /// Frames that show the object mostly hidden (behind the hand) are tracked, not integrated
+  /// (hidden_span.h).
+  HiddenOptions hidden;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -251,6 +255,9 @@ struct FusionResult {
   /// Whether ICP started from the previous pose won over the registration's (see
   /// FusionOptions::icp_retry_fraction).
   bool icp_from_previous = false;
+  /// Whether the frame showed the object mostly hidden (FusionOptions::hidden): registered and
+  /// tracked, not integrated (nor taken to show what the surface leaves free).
+  bool hidden = false;
   /// Where the colours weighed the object standing still (FusionOptions::colour_weighs_still):
   /// their correlation there (else NaN), and whether it won.
   double colour_still_correlation = std::numeric_limits<double>::quiet_NaN();
@@ -319,6 +326,8 @@ class ObjectFusion {
   ObjectPixels FindObject(const Frame& frame, const std::vector<std::uint8_t>& mask) const;
   // The first frame: places the volume around the object and integrates it.
   void Start(const FusionInput& input, const ObjectPixels& object, FusionResult* result);
+  // Takes `pose` as the object's (the motion from the previous one as the last step).
+  void Follow(const Rigid3& pose, FusionResult* result);
   // Takes `pose` as the object's, integrates the frame at it and keeps its free space.
   void Integrate(const FusionInput& input, const ObjectPixels& object, const Rigid3& pose,
                  FusionResult* result);
@@ -338,6 +347,9 @@ class ObjectFusion {
   // it replaces when ICP succeeds; false when neither the registration nor ICP found a pose.
   bool Refine(const ObjectPixels& object, const std::vector<PointMatch>& contacts, Rigid3* pose,
               FusionResult* result);
+  // Whether at least FusionOptions::hidden's covered_share of the pixels the model covers at
+  // `pose` (a whole-image raycast) show something nearer than it rather than the object.
+  bool CoveredByNearer(const ObjectPixels& object, const Rigid3& pose);
   // Whether the registration's contacts spread far enough to fix a turn.
   bool ContactsSpread(const FusionResult& result) const;
   // The contacts that hold ICP, at where the registered `pose` moves them.
@@ -397,6 +409,8 @@ class ObjectFusion {
   FreeSpace free_space_;
   // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
   RaycastImage model_image_;
+  // The model seen at a frame's pose where it may show the object hidden (CoveredByNearer).
+  RaycastImage hidden_image_;
   // Where model_image_ was raycast from (cam_from_object).
   Rigid3 model_image_pose_;
   std::vector<std::uint16_t> near_depth_;
@@ -420,6 +434,7 @@ class ObjectFusion {
   // The hand's vertices in the previous frame, when it was registered (else empty).
   std::vector<Eigen::Vector3f> previous_hand_;
   TurnCarry turn_carry_;
+  HiddenSpan hidden_;
   KeyframeGraph keyframes_;
   // Frames fused so far (the stamp of keyframes and views).
   int fused_frames_ = 0;

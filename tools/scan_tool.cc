@@ -171,6 +171,10 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
         "kept the object standing still against the turn the registration gave it\n",
         aligned, count(summary, "colour_still_frames"));
   }
+  if (const int hidden = count(summary, "hidden_frames"); hidden > 0) {
+    std::printf("  %d frames showed the object mostly hidden behind the hand: tracked, not fused\n",
+                hidden);
+  }
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
   std::printf(
