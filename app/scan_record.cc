@@ -150,6 +150,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["hidden"] = true;
       ++hidden_frames_;
     }
+    if (fused.jump_taken) entry["jump_taken"] = true, ++jumps_taken_;
     if (fused.keyframe) entry["keyframe"] = true, ++keyframes_;
     if (fused.loops > 0) entry["loops"] = fused.loops, loops_ += fused.loops;
     if (fused.feature_loops > 0) {
@@ -218,6 +219,7 @@ nlohmann::json ScanRecord::Summary() const {
                             {"colour_aligned_frames", colour_frames_},
                             {"colour_still_frames", colour_still_frames_},
                             {"hidden_frames", hidden_frames_},
+                            {"jumps_taken", jumps_taken_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},
                             {"hand_undecided_frames", hand_undecided_frames_},

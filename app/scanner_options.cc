@@ -405,10 +405,11 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "view shows the object hidden: tracked, not integrated (0: never)");
   r.Add("fusion.hidden.reference_frames", &u.hidden.reference_frames,
         "... over this many recent frames in view");
-  r.Add("fusion.hidden.covered_share", &u.hidden.covered_share,
-        "... and where this share of the pixels the model covers at the frame's pose show "
-        "something nearer");
-  r.Add("fusion.hidden.cover_margin_mm", &u.hidden.cover_margin_mm, "... nearer by this much, mm");
+  r.Add("fusion.hidden.shown_share", &u.hidden.shown_share,
+        "... and where it shows the object at fewer than this share of the pixels where the "
+        "model is in view at the frame's pose (0: not checked)");
+  r.Add("fusion.hidden.background_margin_mm", &u.hidden.background_margin_mm,
+        "... pixels more than this far behind the model show the background: not counted, mm");
   r.Add("fusion.predict_moving", &u.predict_moving,
         "where nothing registers a frame, the object moves on as in the last frame (when the "
         "surface left no direction free there; off by default)");
@@ -427,6 +428,8 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "a frame moving the object's centre farther than this is rejected, mm");
   r.Add("fusion.max_jump_deg", &u.max_jump_deg,
         "a frame turning the object more than this is rejected, degrees");
+  r.Add("fusion.jump_held_frames", &u.jump_held_frames,
+        "... unless the jump holds over this many frames in a row: then it is taken (0: never)");
   r.Add("fusion.anchor_contacts", &u.anchor_contacts,
         "contacts held over frames are anchored at one object point (off: paper's chaining)");
   r.Add("fusion.contact_noise_reference_mm", &u.contact_noise_reference_mm,

@@ -9,9 +9,9 @@ namespace ihs::fusion {
 void HiddenOptions::Check() const {
   IHS_CHECK_ARG(share >= 0 && share < 1, "fusion.hidden.share must be in [0, 1)");
   IHS_CHECK_ARG(reference_frames >= 1, "fusion.hidden.reference_frames must be at least 1");
-  IHS_CHECK_ARG(covered_share >= 0 && covered_share <= 1,
-                "fusion.hidden.covered_share must be in [0, 1]");
-  IHS_CHECK_ARG(cover_margin_mm >= 0, "fusion.hidden.cover_margin_mm must be >= 0");
+  IHS_CHECK_ARG(shown_share >= 0 && shown_share <= 1,
+                "fusion.hidden.shown_share must be in [0, 1]");
+  IHS_CHECK_ARG(background_margin_mm >= 0, "fusion.hidden.background_margin_mm must be >= 0");
 }
 
 HiddenSpan::HiddenSpan(HiddenOptions options) : options_((options.Check(), options)) {}

@@ -1,6 +1,6 @@
 #pragma once
 // The object hidden behind the hand: frames that show only a small part of what the frames
-// before showed, the rest of the model covered by something nearer, are registered and
+// before showed, and of what the model says is in view at their pose, are registered and
 // tracked, but not integrated into the model.
 //
 // A hand that turns a box can cover most of it for a second or more: those frames keep a few
@@ -10,7 +10,8 @@
 // corrupted model, consistently and wrongly (a generated box turn ended 67° off with its model
 // 42 mm too large). Kept out of the model they cannot corrupt it: where the object shows itself
 // again, it is aligned against a model that is still whole (docs/fusion.md, "The object hidden
-// behind the hand").
+// behind the hand"). The segmentation losing most of the object (a red face taken for skin)
+// looks the same and is held out alike.
 
 #include <deque>
 
@@ -19,22 +20,23 @@ namespace ihs::fusion {
 /// Options of the hold while the object is hidden (defaults in the field comments).
 struct HiddenOptions {
   /// A frame hides the object where it shows fewer than this share of the most object points
-  /// of the last `reference_frames` frames that did not (0, the default: never hidden; every
-  /// frame is integrated). A box turning in view shows between about half and all of its
-  /// largest view; behind the hand a tenth to a third. Off by default: at 0.4 with the point
-  /// count alone (`covered_share` 0) it found two lost held-out box turns of ten but lost a flat
-  /// object turned edge-on, which shows few points with nothing covering it; with the covering
-  /// checked (0.5) it kept that one and the held-out boxes went back to lost (docs/fusion.md,
-  /// "The object hidden behind the hand").
-  double share = 0.0;
+  /// of the last `reference_frames` frames that did not (0: never hidden; every frame is
+  /// integrated). A box turning in view shows between about half and all of its largest view;
+  /// behind the hand, or with most of it lost to the segmentation, a tenth to a third.
+  double share = 0.4;
   int reference_frames = 30;
-  /// ... and where at least this share of the pixels the model covers at the frame's registered
-  /// pose (ObjectFusion raycasts it) show something nearer than the model (the hand) rather
-  /// than the object (0: not checked): a flat object turned edge-on shows few points too, but
-  /// nothing covers it.
-  double covered_share = 0.5;
-  /// How much nearer than the model a pixel's depth must be to cover it, mm.
-  double cover_margin_mm = 10.0;
+  /// ... and where the frame shows the object at fewer than this share of the pixels where
+  /// the model, raycast at the frame's registered pose, says it is in view (0: not checked).
+  /// Behind the hand, or where the segmentation lost most of it (a red face taken for skin),
+  /// the frame shows a patch of what the model says is there: 0.1-0.55 in the generated box
+  /// turns; in view 0.6-0.9 (the mask leaves out the object's edges and what touches the
+  /// hand). A flat object turned edge-on shows few points too, but all that the model says is
+  /// in view (0.97-1.0): by the point count alone it was held out and lost (docs/fusion.md,
+  /// "The object hidden behind the hand").
+  double shown_share = 0.7;
+  /// Pixels whose depth lies more than this behind the model's (mm) show what is behind it: the
+  /// model is not there (its edges, a pose a little off), and they do not count.
+  double background_margin_mm = 10.0;
 
   /// Throws std::invalid_argument naming the bad field.
   void Check() const;

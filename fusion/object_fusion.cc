@@ -43,6 +43,7 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(loose_contact_mm > 0, "fusion.loose_contact_mm must be positive");
   IHS_CHECK_ARG(max_jump_mm > 0 && max_jump_deg > 0,
                 "fusion.max_jump_mm and max_jump_deg must be positive");
+  IHS_CHECK_ARG(jump_held_frames >= 0, "fusion.jump_held_frames must not be negative");
   IHS_CHECK_ARG(anchor_slip_mm > 0, "fusion.anchor_slip_mm must be positive");
   IHS_CHECK_ARG(free_turn_min_visual_inliers >= 3,
                 "fusion.free_turn_min_visual_inliers must be at least 3");
@@ -186,6 +187,11 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   auto finish = [&](FusionStatus status, std::string reason = {}) {
     return Finish(input, started_at, status, std::move(reason), &result);
   };
+  if (input.hand_motion) {
+    hand_turn_since_ = input.hand_motion->rotation() * hand_turn_since_;
+  } else {
+    hand_turn_known_ = false;
+  }
   const ObjectPixels object = FindObject(*input.frame, *input.object_mask);
   // Only where the surface fixes every direction (a box): elsewhere the model's shape does not
   // show a wrong turn about the free axis, and holding frames out lost more of it (small
@@ -225,14 +231,20 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     return finish(FusionStatus::kSkipped, "no registration: " + result.pairwise.reason);
   }
 
+  if (result.hidden && options_.hidden.shown_share > 0) {
+    result.hidden = ShowsLittleOfModel(object, pose);
+  }
+  // A patch of the object says little of what its surface leaves free.
+  if (result.icp.ok && !result.hidden) turn_carry_.ObserveSurface(result.icp.free_directions);
   const Rigid3 step = pose * cam_from_object_.Inverse();
-  if (std::string jump = ImplausibleJump(pose, step); !jump.empty()) {
+  if (std::string jump = ImplausibleJump(cam_from_object_, pose); jump.empty()) {
+    jump_held_ = 0;
+  } else if (JumpHolds(pose, result.icp.ok)) {
+    result.jump_taken = true;
+  } else {
     return finish(FusionStatus::kSkipped, std::move(jump));
   }
   UpdateContactNoise(contacts, step, &result);
-  if (result.hidden && options_.hidden.covered_share > 0) {
-    result.hidden = CoveredByNearer(object, pose);
-  }
   if (result.hidden) {
     // Tracked, not integrated: a few hundred points registered from a patch may be turned far
     // off, and would write that turn into the model.
@@ -315,6 +327,8 @@ void ObjectFusion::Start(const FusionInput& input, const ObjectPixels& object,
 void ObjectFusion::Follow(const Rigid3& pose, FusionResult* result) {
   if (started_) last_step_ = pose * cam_from_object_.Inverse();
   cam_from_object_ = pose;
+  hand_turn_since_.setIdentity();
+  hand_turn_known_ = true;
   result->cam_from_object = pose;
 }
 
@@ -448,32 +462,30 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     WeighStillByColour(object, setup, icp_predicted, pose, result);
     last_paired_ = static_cast<double>(result->icp.inliers) / object.points.size();
     surface_left_free_ = result->icp.free_directions != 0;
-    // A patch of the object says little of what its surface leaves free.
-    if (!result->hidden) turn_carry_.ObserveSurface(result->icp.free_directions);
     return true;
   }
   return result->pairwise.ok;
 }
 
-bool ObjectFusion::CoveredByNearer(const ObjectPixels& object, const Rigid3& pose) {
+bool ObjectFusion::ShowsLittleOfModel(const ObjectPixels& object, const Rigid3& pose) {
   // The whole image: rays are followed only through the box of observed voxels.
   volume_.Raycast(intrinsics_, pose, {0, 0, 0, 0}, nullptr, 0, &hidden_image_);
   const auto [u0, v0, u1, v1] = hidden_image_.written;
-  int seen = 0, covered = 0;
+  int in_view = 0, shown = 0;
   for (int v = v0; v < v1; ++v) {
     for (int u = u0; u < u1; ++u) {
       const int pixel = v * hidden_image_.width + u;
       const float model = hidden_image_.depth_mm[pixel];
       if (!(model > 0)) continue;
+      // Something behind where the model is: the model is not there (its edges, a pose a little
+      // off), rather than the object hidden.
       const std::uint16_t depth = object.frame.depth_mm[pixel];
-      if (object.mask[pixel]) {
-        ++seen;
-      } else if (depth > 0 && depth < model - options_.hidden.cover_margin_mm) {
-        ++covered;
-      }
+      if (depth > model + options_.hidden.background_margin_mm) continue;
+      ++in_view;
+      if (object.mask[pixel]) ++shown;
     }
   }
-  return covered > 0 && covered >= options_.hidden.covered_share * (seen + covered);
+  return in_view > 0 && shown < options_.hidden.shown_share * in_view;
 }
 
 bool ObjectFusion::ContactsSpread(const FusionResult& result) const {
@@ -619,10 +631,10 @@ void ObjectFusion::WeighStillByColour(const ObjectPixels& object, const IcpSetup
   }
 }
 
-std::string ObjectFusion::ImplausibleJump(const Rigid3& pose, const Rigid3& step) const {
-  // A plausible step from the previous pose?
-  const double moved = (pose.translation() - cam_from_object_.translation()).norm();
-  const double turned = Eigen::AngleAxisd(step.rotation()).angle() * 180.0 / M_PI;
+std::string ObjectFusion::ImplausibleJump(const Rigid3& from, const Rigid3& to) const {
+  const double moved = (to.translation() - from.translation()).norm();
+  const double turned =
+      Eigen::AngleAxisd(to.rotation() * from.rotation().transpose()).angle() * 180.0 / M_PI;
   if (moved > options_.max_jump_mm || turned > options_.max_jump_deg) {
     char reason[128];
     std::snprintf(reason, sizeof reason, "implausible jump: %.1f mm, %.1f° from the last frame",
@@ -630,6 +642,30 @@ std::string ObjectFusion::ImplausibleJump(const Rigid3& pose, const Rigid3& step
     return reason;
   }
   return {};
+}
+
+bool ObjectFusion::JumpHolds(const Rigid3& pose, bool icp_found) {
+  // Only ICP against a model whose shape fixes every direction finds where the object is; a
+  // turn the surface leaves free comes from the frame's motion alone (the hand, the features),
+  // and a wrong one may hold as well. And the hand that holds the object must have turned the
+  // same way since the last pose, within the jump limit: ICP may find a box turned 90° from
+  // where it is just as consistently.
+  const double off_hand_deg =
+      Eigen::AngleAxisd(pose.rotation() *
+                        (hand_turn_since_ * cam_from_object_.rotation()).transpose())
+          .angle() *
+      180.0 / M_PI;
+  if (!icp_found || turn_carry_.SurfaceLeavesTurnFree() || !hand_turn_known_ ||
+      off_hand_deg > options_.max_jump_deg) {
+    jump_held_ = 0;
+    return false;
+  }
+  const bool again = jump_held_ > 0 && ImplausibleJump(jumped_to_, pose).empty();
+  jump_held_ = again ? jump_held_ + 1 : 1;
+  jumped_to_ = pose;
+  if (options_.jump_held_frames == 0 || jump_held_ < options_.jump_held_frames) return false;
+  jump_held_ = 0;
+  return true;
 }
 
 void ObjectFusion::UpdateContactNoise(const std::vector<PointMatch>& contacts, const Rigid3& step,

@@ -124,6 +124,14 @@ struct FusionOptions {
   /// from the previous frame is implausible: the frame is skipped, not integrated.
   double max_jump_mm = 40.0;
   double max_jump_deg = 30.0;
+  /// ... unless the jump holds: found again by ICP where the surface fixes every direction (a
+  /// box; not a ball's turn, which the frame's motion alone gives), each within those limits of
+  /// the last, in this many frames in a row, and within `max_jump_deg` of the turn the tracked
+  /// hand made since the last pose; then the object did move there (it turned while the hand
+  /// hid it, and every later frame finds it there) and the pose is taken (0: never). Without
+  /// it a box that turned 33° while nothing of it was seen was refused in every one of the 42
+  /// frames that followed (docs/fusion.md, "The object hidden behind the hand").
+  int jump_held_frames = 3;
   /// A fingertip contact held over consecutive frames is anchored at one point of the object
   /// (the mean of where it was seen, in the object frame) rather than only at where the
   /// previous frame had it: while a grasp holds, the hand tracker's noise does not add up from
@@ -258,6 +266,9 @@ struct FusionResult {
   /// Whether the frame showed the object mostly hidden (FusionOptions::hidden): registered and
   /// tracked, not integrated (nor taken to show what the surface leaves free).
   bool hidden = false;
+  /// Whether the pose jumped farther from the previous one than FusionOptions::max_jump_mm or
+  /// max_jump_deg allow and was taken, the jump having held (FusionOptions::jump_held_frames).
+  bool jump_taken = false;
   /// Where the colours weighed the object standing still (FusionOptions::colour_weighs_still):
   /// their correlation there (else NaN), and whether it won.
   double colour_still_correlation = std::numeric_limits<double>::quiet_NaN();
@@ -347,9 +358,9 @@ class ObjectFusion {
   // it replaces when ICP succeeds; false when neither the registration nor ICP found a pose.
   bool Refine(const ObjectPixels& object, const std::vector<PointMatch>& contacts, Rigid3* pose,
               FusionResult* result);
-  // Whether at least FusionOptions::hidden's covered_share of the pixels the model covers at
-  // `pose` (a whole-image raycast) show something nearer than it rather than the object.
-  bool CoveredByNearer(const ObjectPixels& object, const Rigid3& pose);
+  // Whether the frame shows the object at fewer than FusionOptions::hidden's shown_share of the
+  // pixels where the model, raycast at `pose` over the whole image, is in view.
+  bool ShowsLittleOfModel(const ObjectPixels& object, const Rigid3& pose);
   // Whether the registration's contacts spread far enough to fix a turn.
   bool ContactsSpread(const FusionResult& result) const;
   // The contacts that hold ICP, at where the registered `pose` moves them.
@@ -370,8 +381,12 @@ class ObjectFusion {
   // (FusionOptions::colour_weighs_still).
   void WeighStillByColour(const ObjectPixels& object, const IcpSetup& setup,
                           const Rigid3& icp_predicted, Rigid3* pose, FusionResult* result);
-  // Why the step from the previous pose to `pose` is implausible (empty when it is not).
-  std::string ImplausibleJump(const Rigid3& pose, const Rigid3& step) const;
+  // Why the step from `from` to `to` is implausible (empty when it is not).
+  std::string ImplausibleJump(const Rigid3& from, const Rigid3& to) const;
+  // Whether an implausible jump to `pose` has now held for FusionOptions::jump_held_frames
+  // frames in a row (each within the limits of the last), found by ICP (`icp_found`) where the
+  // surface fixes every direction, and agrees with the hand's turn since the last pose.
+  bool JumpHolds(const Rigid3& pose, bool icp_found);
   // Updates the running estimate of the contacts' noise from how far `step` leaves them.
   void UpdateContactNoise(const std::vector<PointMatch>& contacts, const Rigid3& step,
                           FusionResult* result);
@@ -435,6 +450,13 @@ class ObjectFusion {
   std::vector<Eigen::Vector3f> previous_hand_;
   TurnCarry turn_carry_;
   HiddenSpan hidden_;
+  // The last implausible jump's pose and how many frames in a row it has held.
+  Rigid3 jumped_to_;
+  int jump_held_ = 0;
+  // The hand's turn (camera frame) since the frame the pose was last taken in, and whether the
+  // tracker followed the hand in every frame since (FusionInput::hand_motion).
+  Eigen::Matrix3d hand_turn_since_ = Eigen::Matrix3d::Identity();
+  bool hand_turn_known_ = true;
   KeyframeGraph keyframes_;
   // Frames fused so far (the stamp of keyframes and views).
   int fused_frames_ = 0;

@@ -175,6 +175,12 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
     std::printf("  %d frames showed the object mostly hidden behind the hand: tracked, not fused\n",
                 hidden);
   }
+  if (const int jumps = count(summary, "jumps_taken"); jumps > 0) {
+    std::printf(
+        "  %d times the object was found far from where it was, frames in a row: taken as "
+        "having moved there unseen\n",
+        jumps);
+  }
   const auto& ms = summary["ms_per_frame"];
   auto mean = [&](const char* key) { return ms.contains(key) ? ms[key].get<double>() : 0.0; };
   std::printf(

@@ -32,8 +32,8 @@ TEST(HiddenSpanTest, AFrameWithFewPointsAgainstTheRecentFramesInViewHidesTheObje
 }
 
 TEST(HiddenSpanTest, ShareZeroNeverHidesAndBadOptionsAreRefused) {
-  HiddenOptions off;  // The default.
-  EXPECT_EQ(off.share, 0);
+  HiddenOptions off;
+  off.share = 0;
   HiddenSpan span(off);
   for (int points : {3000, 10, 0, 3000}) EXPECT_FALSE(span.Observe(points));
   HiddenOptions bad;
@@ -41,6 +41,12 @@ TEST(HiddenSpanTest, ShareZeroNeverHidesAndBadOptionsAreRefused) {
   EXPECT_THROW(HiddenSpan{bad}, std::invalid_argument);
   bad = {};
   bad.reference_frames = 0;
+  EXPECT_THROW(HiddenSpan{bad}, std::invalid_argument);
+  bad = {};
+  bad.shown_share = 1.5;
+  EXPECT_THROW(HiddenSpan{bad}, std::invalid_argument);
+  bad = {};
+  bad.background_margin_mm = -1;
   EXPECT_THROW(HiddenSpan{bad}, std::invalid_argument);
 }
 

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "tests/frame_fixtures.h"
+#include "tests/free_space_fixtures.h"
 #include "tests/test_util.h"
 
 namespace ihs::fusion {
@@ -430,7 +431,6 @@ TEST(ObjectFusionTest, FramesThatShowTheObjectMostlyHiddenAreTrackedNotIntegrate
   options.colour.enabled = false;
   options.silhouette.weight = 0;
   options.pairwise.visual_turn_prior_deg = 0;  // The features' own turn, as exact as they are.
-  options.hidden.share = 0.4;                  // Off by default.
   ObjectFusion fusion(kIntrinsics, options);
   const std::vector<Eigen::Vector3d> spots = SurfaceSpots(axes, 400);
   Rigid3 object_from_volume;
@@ -492,6 +492,33 @@ TEST(ObjectFusionTest, FramesThatShowTheObjectMostlyHiddenAreTrackedNotIntegrate
   EXPECT_LT(worst_mm, 3.0);
 }
 
+TEST(ObjectFusionTest, AFlatObjectTurnedEdgeOnIsIntegratedThoughItShowsFewPoints) {
+  // The flat ellipsoid of the loose contacts' test turned edge-on shows a third of its most
+  // points with nothing covering it. By the point count alone those frames are held out as
+  // hidden, the model never sees its edge, and ICP alone loses it; but such a frame shows all
+  // that the model says is in view at its pose (HiddenOptions::shown_share), and with that
+  // checked none is held out.
+  const Eigen::Vector3d axes(50, 28, 12);
+  FusionOptions count_alone;
+  count_alone.hidden.shown_share = 0;
+  const FusionOptions shown;
+  const SequenceRun by_count = FuseSequence(axes, 6, count_alone, 0, 0, 15.0);
+  const SequenceRun by_shown = FuseSequence(axes, 6, shown, 0, 0, 15.0);
+  auto hidden = [](const SequenceRun& run) {
+    return std::count_if(run.results.begin(), run.results.end(),
+                         [](const FusionResult& r) { return r.hidden; });
+  };
+  std::printf(
+      "flat ellipsoid: %d frames held out by the point count alone (worst pose error %.1f mm), "
+      "%d with what the model shows checked (%.2f mm)\n",
+      static_cast<int>(hidden(by_count)), by_count.pose_error_mm,
+      static_cast<int>(hidden(by_shown)), by_shown.pose_error_mm);
+  EXPECT_GT(hidden(by_count), 0);
+  EXPECT_EQ(hidden(by_shown), 0);
+  EXPECT_EQ(Count(by_shown, FusionStatus::kFused), kFrames - 1);
+  EXPECT_LT(by_shown.pose_error_mm, 3.0);
+}
+
 TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   const Eigen::Vector3d axes(45, 30, 18);
   ObjectFusion fusion(kIntrinsics);
@@ -520,6 +547,66 @@ TEST(ObjectFusionTest, EmptyFramesAndImplausibleJumpsAreSkippedWithAReason) {
   result = contacts_only.Fuse(jump);
   EXPECT_EQ(result.status, FusionStatus::kSkipped);
   EXPECT_NE(result.reason.find("implausible jump"), std::string::npos) << result.reason;
+}
+
+TEST(ObjectFusionTest, AJumpThatHoldsIsTheObjectsAndIsTaken) {
+  // Ten frames of a 40 mm cube's turn, then the cube as it is 32° further on, in five frames:
+  // it turned, with the hand that holds it, while nothing of it was seen. ICP finds it there
+  // from the last pose, a step past FusionOptions::max_jump_deg: refused in the first two
+  // frames; found again, within the limits of the last, in a third, the jump has held and is
+  // taken. Not where the hand did not turn with it, nor with jump_held_frames 0. (On the smooth
+  // ellipsoid ICP walks there a few degrees a frame instead: no jump.)
+  const Eigen::Vector3d corner = Eigen::Vector3d::Constant(test::kCubeEdgeMm / 2);
+  constexpr int kSeen = 10, kAfter = 5, kSkippedTurn = 8;
+  auto run = [&](int held_frames, bool hand_turns, std::vector<FusionResult>* results) {
+    FusionOptions options;
+    options.jump_held_frames = held_frames;
+    ObjectFusion fusion(kIntrinsics, options);
+    Rigid3 object_from_volume;
+    double worst_mm = 0;
+    int previous = 0;
+    for (int i = 0; i < kSeen + kAfter; ++i) {
+      const int truth = i < kSeen ? i : kSeen - 1 + kSkippedTurn;
+      const Frame frame = test::CubeView(kIntrinsics, Truth(truth)).frame;
+      std::vector<std::uint8_t> mask(frame.depth_mm.size());
+      for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+      FusionInput input{&frame, &mask, {}};
+      // The hand's root turns with the object (or stays where it was).
+      input.hand_motion = hand_turns ? Truth(truth) * Truth(previous).Inverse() : Rigid3();
+      previous = truth;
+      const FusionResult result = fusion.Fuse(input);
+      if (i == 0) object_from_volume = Truth(0).Inverse() * result.cam_from_object;
+      if (i >= kSeen) results->push_back(result);
+      if (result.status == FusionStatus::kSkipped) continue;
+      for (int axis = 0; axis < 3; ++axis) {
+        Eigen::Vector3d p = corner;
+        p[axis] = -p[axis];
+        const Eigen::Vector3d in_volume = object_from_volume.Inverse() * p;
+        worst_mm = std::max(worst_mm, (result.cam_from_object * in_volume -
+                                       Truth(truth) * object_from_volume * in_volume)
+                                          .norm());
+      }
+    }
+    return worst_mm;
+  };
+  std::vector<FusionResult> taken, refused, hand_still;
+  const double taken_mm = run(3, true, &taken);
+  run(0, true, &refused);
+  run(3, false, &hand_still);
+  std::printf("a held jump: taken in frame %d after the turn, worst pose error %.2f mm\n",
+              static_cast<int>(std::find_if(taken.begin(), taken.end(),
+                                            [](const FusionResult& r) { return r.jump_taken; }) -
+                               taken.begin()),
+              taken_mm);
+  for (int k = 0; k < kAfter; ++k) {
+    for (const FusionResult& result : {refused[k], hand_still[k]}) {
+      EXPECT_EQ(result.status, FusionStatus::kSkipped) << k;
+      EXPECT_NE(result.reason.find("implausible jump"), std::string::npos) << result.reason;
+    }
+    EXPECT_EQ(taken[k].status, k < 2 ? FusionStatus::kSkipped : FusionStatus::kFused) << k;
+    EXPECT_EQ(taken[k].jump_taken, k == 2) << k;
+  }
+  EXPECT_LT(taken_mm, 3.0);
 }
 
 }  // namespace
