@@ -470,7 +470,9 @@ TEST(ObjectFusionTest, FramesThatShowTheObjectMostlyHiddenAreTrackedNotIntegrate
     ASSERT_NE(result.status, FusionStatus::kSkipped) << "frame " << i << ": " << result.reason;
     if (result.hidden) hidden.push_back(i);
     if (result.integrated_voxels > 0) integrated.push_back(i);
-    if (i == kHideTo - 1) EXPECT_EQ(fusion.ExtractMesh().vertices.size(), vertices_before);
+    if (i == kHideTo - 1) {
+      EXPECT_EQ(fusion.ExtractMesh().vertices.size(), vertices_before);
+    }
     if (i == 0) object_from_volume = Truth(0).Inverse() * result.cam_from_object;
     for (int axis = 0; axis < 3; ++axis) {
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
