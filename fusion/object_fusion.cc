@@ -188,7 +188,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
     return Finish(input, started_at, status, std::move(reason), &result);
   };
   if (input.hand_motion) {
-    hand_turn_since_ = input.hand_motion->rotation() * hand_turn_since_;
+    hand_turn_since_ = *input.hand_motion * hand_turn_since_;
   } else {
     hand_turn_known_ = false;
   }
@@ -327,7 +327,7 @@ void ObjectFusion::Start(const FusionInput& input, const ObjectPixels& object,
 void ObjectFusion::Follow(const Rigid3& pose, FusionResult* result) {
   if (started_) last_step_ = pose * cam_from_object_.Inverse();
   cam_from_object_ = pose;
-  hand_turn_since_.setIdentity();
+  hand_turn_since_ = Rigid3();
   hand_turn_known_ = true;
   result->cam_from_object = pose;
 }
@@ -633,8 +633,7 @@ void ObjectFusion::WeighStillByColour(const ObjectPixels& object, const IcpSetup
 
 std::string ObjectFusion::ImplausibleJump(const Rigid3& from, const Rigid3& to) const {
   const double moved = (to.translation() - from.translation()).norm();
-  const double turned =
-      Eigen::AngleAxisd(to.rotation() * from.rotation().transpose()).angle() * 180.0 / M_PI;
+  const double turned = from.RotationAngleToRad(to) * 180.0 / M_PI;
   if (moved > options_.max_jump_mm || turned > options_.max_jump_deg) {
     char reason[128];
     std::snprintf(reason, sizeof reason, "implausible jump: %.1f mm, %.1f° from the last frame",
@@ -651,10 +650,7 @@ bool ObjectFusion::JumpHolds(const Rigid3& pose, bool icp_found) {
   // same way since the last pose, within the jump limit: ICP may find a box turned 90° from
   // where it is just as consistently.
   const double off_hand_deg =
-      Eigen::AngleAxisd(pose.rotation() *
-                        (hand_turn_since_ * cam_from_object_.rotation()).transpose())
-          .angle() *
-      180.0 / M_PI;
+      (hand_turn_since_ * cam_from_object_).RotationAngleToRad(pose) * 180.0 / M_PI;
   if (!icp_found || turn_carry_.SurfaceLeavesTurnFree() || !hand_turn_known_ ||
       off_hand_deg > options_.max_jump_deg) {
     jump_held_ = 0;

@@ -453,9 +453,9 @@ class ObjectFusion {
   // The last implausible jump's pose and how many frames in a row it has held.
   Rigid3 jumped_to_;
   int jump_held_ = 0;
-  // The hand's turn (camera frame) since the frame the pose was last taken in, and whether the
+  // The hand's motion (camera frame) since the frame the pose was last taken in, and whether the
   // tracker followed the hand in every frame since (FusionInput::hand_motion).
-  Eigen::Matrix3d hand_turn_since_ = Eigen::Matrix3d::Identity();
+  Rigid3 hand_turn_since_;
   bool hand_turn_known_ = true;
   KeyframeGraph keyframes_;
   // Frames fused so far (the stamp of keyframes and views).
