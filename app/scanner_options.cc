@@ -51,6 +51,10 @@ void AddSegmentationOptions(OptionRegistry& r, tracker::SegmentationOptions* seg
         "neighbouring pixels join one region when their depths differ by at most this, mm");
   r.Add("tracker.segmentation.min_region_pixels", &s.min_region_pixels,
         "regions smaller than this many pixels are dropped");
+  r.Add("tracker.segmentation.speck_enclosed_share", &s.speck_enclosed_share,
+        "a small skin region with this share of its outline on the object joins it (0: off)");
+  r.Add("tracker.segmentation.speck_step_mm", &s.speck_step_mm,
+        "depth step across a skin speck's outline still on the object's surface, mm");
   r.Add("tracker.segmentation.connect_gap_px", &s.connect_gap_px,
         "pixels also join a region across this many pixels without depth (0: neighbours only)");
   r.Add("tracker.segmentation.boundary_px", &s.boundary_px,

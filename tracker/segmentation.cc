@@ -55,6 +55,58 @@ std::vector<int> Regions(const std::vector<std::uint8_t>& classes,
   return region;
 }
 
+// Re-classes skin regions smaller than `min_pixels` whose outline lies on a non-skin surface
+// as kOther: of the pixels just outside the region, at least `enclosed_share` are non-skin within
+// `step_mm` in depth. Returns whether any changed.
+bool GiveSpecksToObject(std::vector<std::uint8_t>* classes, const std::vector<int>& region,
+                        const std::vector<int>& sizes, const std::vector<std::uint16_t>& depth,
+                        int width, int height, int min_pixels, double enclosed_share,
+                        double step_mm) {
+  std::vector<int> outline(sizes.size(), 0), on_surface(sizes.size(), 0);
+  auto small_skin = [&](size_t i) {
+    return (*classes)[i] == kSkin && sizes[region[i]] < min_pixels;
+  };
+  const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  for (size_t i = 0; i < classes->size(); ++i) {
+    if (!small_skin(i)) continue;
+    const int u = static_cast<int>(i % width), v = static_cast<int>(i / width);
+    for (const auto& step : steps) {
+      const int uu = u + step[0], vv = v + step[1];
+      const bool in_box = uu >= 0 && vv >= 0 && uu < width && vv < height;
+      const size_t q = in_box ? static_cast<size_t>(vv) * width + uu : 0;
+      if (in_box && region[q] == region[i]) continue;
+      ++outline[region[i]];
+      on_surface[region[i]] +=
+          in_box && (*classes)[q] == kOther &&
+          std::abs(static_cast<int>(depth[q]) - static_cast<int>(depth[i])) <= step_mm;
+    }
+  }
+  bool changed = false;
+  for (size_t i = 0; i < classes->size(); ++i) {
+    const int id = small_skin(i) ? region[i] : -1;
+    if (id < 0 || outline[id] == 0 || on_surface[id] < enclosed_share * outline[id]) continue;
+    (*classes)[i] = kOther;
+    changed = true;
+  }
+  return changed;
+}
+
+// Regions (above) of a width × height box of classes, once skin specks printed on the object
+// have been given to it (GiveSpecksToObject).
+std::vector<int> ClassRegions(std::vector<std::uint8_t>* classes,
+                              const std::vector<std::uint16_t>& depth, int width, int height,
+                              const SegmentationOptions& options, std::vector<int>* sizes) {
+  const std::vector<int> region = Regions(*classes, depth, width, height, options.connect_depth_mm,
+                                          options.connect_gap_px, sizes);
+  if (options.speck_enclosed_share == 0 ||
+      !GiveSpecksToObject(classes, region, *sizes, depth, width, height, options.min_region_pixels,
+                          options.speck_enclosed_share, options.speck_step_mm)) {
+    return region;
+  }
+  return Regions(*classes, depth, width, height, options.connect_depth_mm, options.connect_gap_px,
+                 sizes);
+}
+
 }  // namespace
 
 void SegmentationOptions::Check() const {
@@ -63,6 +115,9 @@ void SegmentationOptions::Check() const {
   IHS_CHECK_ARG(crop_min_mm.z() > 0, "segmentation.crop_min_mm.z must be positive");
   IHS_CHECK_ARG(connect_depth_mm > 0, "segmentation.connect_depth_mm must be positive");
   IHS_CHECK_ARG(min_region_pixels >= 0, "segmentation.min_region_pixels must be >= 0");
+  IHS_CHECK_ARG(speck_enclosed_share >= 0 && speck_enclosed_share <= 1,
+                "segmentation.speck_enclosed_share must be in [0, 1]");
+  IHS_CHECK_ARG(speck_step_mm >= 0, "segmentation.speck_step_mm must be >= 0");
   IHS_CHECK_ARG(connect_gap_px >= 0 && connect_gap_px <= 8,
                 "segmentation.connect_gap_px must be in [0, 8]");
   IHS_CHECK_ARG(boundary_px >= 0 && boundary_px <= 20,
@@ -144,10 +199,9 @@ Segmentation Segmenter::Segment(const Frame& frame) const {
     classes[i] = skin ? (inside[i] ? kSkin : kNone) : kOther;
   }
 
-  // Depth-connected regions; small ones go.
+  // Depth-connected regions; skin specks printed on the object join it, other small ones go.
   std::vector<int> sizes;
-  const std::vector<int> region =
-      Regions(classes, depth, bw, bh, options_.connect_depth_mm, options_.connect_gap_px, &sizes);
+  const std::vector<int> region = ClassRegions(&classes, depth, bw, bh, options_, &sizes);
   std::vector<std::uint8_t> hand(bn, 0);
   Eigen::Vector3d hand_sum = Eigen::Vector3d::Zero();
   int hand_count = 0;
