@@ -150,6 +150,14 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["hidden"] = true;
       ++hidden_frames_;
     }
+    if (std::isfinite(fused.see_through_share)) {
+      entry["see_through_share"] = fused.see_through_share;
+    }
+    if (fused.see_through_moved) entry["see_through_moved"] = true, ++see_through_moved_frames_;
+    if (fused.see_through_held && fused.status != fusion::FusionStatus::kSkipped) {
+      entry["see_through_held"] = true;
+      ++see_through_held_frames_;
+    }
     if (fused.jump_taken) entry["jump_taken"] = true, ++jumps_taken_;
     if (fused.keyframe) entry["keyframe"] = true, ++keyframes_;
     if (fused.loops > 0) entry["loops"] = fused.loops, loops_ += fused.loops;
@@ -219,6 +227,8 @@ nlohmann::json ScanRecord::Summary() const {
                             {"colour_aligned_frames", colour_frames_},
                             {"colour_still_frames", colour_still_frames_},
                             {"hidden_frames", hidden_frames_},
+                            {"see_through_held_frames", see_through_held_frames_},
+                            {"see_through_moved_frames", see_through_moved_frames_},
                             {"jumps_taken", jumps_taken_},
                             {"hand_carried_frames", hand_carried_frames_},
                             {"hand_back_frames", hand_back_frames_},

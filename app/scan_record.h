@@ -86,6 +86,8 @@ class ScanRecord {
   std::int64_t colour_still_frames_ = 0;
   // Frames that showed the object mostly hidden: tracked, not integrated (fusion/hidden_span.h).
   std::int64_t hidden_frames_ = 0;
+  std::int64_t see_through_held_frames_ = 0;
+  std::int64_t see_through_moved_frames_ = 0;
   // Implausible jumps taken because they held (FusionOptions::jump_held_frames).
   std::int64_t jumps_taken_ = 0;
   // Frames the hand carried the object's turn, and frames it turned back (turn_carry.h).

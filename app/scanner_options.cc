@@ -414,6 +414,16 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "model is in view at the frame's pose (0: not checked)");
   r.Add("fusion.hidden.background_margin_mm", &u.hidden.background_margin_mm,
         "... pixels more than this far behind the model show the background: not counted, mm");
+  r.Add("fusion.see_through.max_share", &u.see_through.max_share,
+        "a frame whose depth lies behind the model, raycast at its pose, at more than this share "
+        "of the model's pixels sees through it: ICP again from the object's points, else "
+        "tracked, not integrated (0: not checked)");
+  r.Add("fusion.see_through.margin_mm", &u.see_through.margin_mm,
+        "... depth more than this far behind the model sees through it, mm");
+  r.Add("fusion.see_through.max_held_frames", &u.see_through.max_held_frames,
+        "... at most this many frames in a row held out; later ones integrated as registered");
+  r.Add("fusion.see_through.step_px", &u.see_through.step_px,
+        "... the model raycast at every this-many-th pixel along each image axis");
   r.Add("fusion.predict_moving", &u.predict_moving,
         "where nothing registers a frame, the object moves on as in the last frame (when the "
         "surface left no direction free there; off by default)");

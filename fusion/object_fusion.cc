@@ -35,6 +35,7 @@ void FusionOptions::Check() const {
   colour.Check();
   silhouette.Check();
   hidden.Check();
+  see_through.Check();
   IHS_CHECK_ARG(
       !model_contacts.enabled ||
           model_contacts.distance_mm < tsdf.truncation_voxels * tsdf.size_mm / tsdf.resolution,
@@ -234,6 +235,7 @@ FusionResult ObjectFusion::Fuse(const FusionInput& input) {
   if (result.hidden && options_.hidden.shown_share > 0) {
     result.hidden = ShowsLittleOfModel(object, pose);
   }
+  if (result.see_through_held) result.hidden = true;
   // A patch of the object says little of what its surface leaves free.
   if (result.icp.ok && !result.hidden) turn_carry_.ObserveSurface(result.icp.free_directions);
   const Rigid3 step = pose * cam_from_object_.Inverse();
@@ -460,11 +462,56 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
     *pose = result->icp.cam_from_volume;
     AlignColours(object, icp_predicted, pose, result);
     WeighStillByColour(object, setup, icp_predicted, pose, result);
+    CheckSeeThrough(object, setup, pose, result);
     last_paired_ = static_cast<double>(result->icp.inliers) / object.points.size();
     surface_left_free_ = result->icp.free_directions != 0;
     return true;
   }
-  return result->pairwise.ok;
+  if (!result->pairwise.ok) return false;
+  CheckSeeThrough(object, setup, pose, result);
+  return true;
+}
+
+SeeThrough ObjectFusion::SeeThroughAt(const ObjectPixels& object, const Rigid3& pose,
+                                      FusionResult* result) {
+  const auto raycast_start = SteadyClock::now();
+  // A sample of the pixels the observed voxels' box projects into.
+  SeeThroughPixels(object.frame, options_.see_through.step_px, &see_through_depth_);
+  volume_.Raycast(intrinsics_, pose, ImageBoxOf(volume_.ObservedBox(), pose, intrinsics_),
+                  &see_through_depth_, kSeeThroughWindowMm, &hidden_image_);
+  result->raycast_ms += MillisecondsSince(raycast_start);
+  return MeasureSeeThrough(hidden_image_, object.frame, intrinsics_, options_.see_through);
+}
+
+void ObjectFusion::CheckSeeThrough(const ObjectPixels& object, const IcpSetup& setup, Rigid3* pose,
+                                   FusionResult* result) {
+  const SeeThroughOptions& options = options_.see_through;
+  if (!(options.max_share > 0)) return;
+  SeeThrough seen = SeeThroughAt(object, *pose, result);
+  if (seen.share() > options.max_share && seen.visible > 0) {
+    RetryOnObjectCentre(object, setup, &seen, pose, result);
+  }
+  result->see_through_share = seen.share();
+  const bool through = seen.share() > options.max_share;
+  see_through_frames_ = through ? see_through_frames_ + 1 : 0;
+  result->see_through_held = through && see_through_frames_ <= options.max_held_frames;
+}
+
+void ObjectFusion::RetryOnObjectCentre(const ObjectPixels& object, const IcpSetup& setup,
+                                       SeeThrough* seen, Rigid3* pose, FusionResult* result) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& point : object.points) centroid += point.cast<double>();
+  centroid /= static_cast<double>(object.points.size());
+  const Rigid3 moved = Rigid3::Translation(centroid - seen->visible_centroid) * *pose;
+  IcpResult retry = AlignAt(object, setup, moved, {}, result);
+  const int inliers = result->icp.ok ? result->icp.inliers : 0;
+  if (!retry.ok || retry.inliers < inliers) return;
+  const SeeThrough again = SeeThroughAt(object, retry.cam_from_volume, result);
+  if (again.share() >= seen->share()) return;
+  *pose = retry.cam_from_volume;
+  result->icp = std::move(retry);
+  result->see_through_moved = true;
+  *seen = again;
 }
 
 bool ObjectFusion::ShowsLittleOfModel(const ObjectPixels& object, const Rigid3& pose) {

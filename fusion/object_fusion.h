@@ -25,6 +25,7 @@
 #include "fusion/keyframe_graph.h"
 #include "fusion/model_contacts.h"
 #include "fusion/pairwise_registration.h"
+#include "fusion/see_through.h"
 #include "fusion/tsdf_volume.h"
 #include "fusion/turn_carry.h"
 #include "fusion/view_coverage.h"
@@ -57,6 +58,10 @@ struct FusionOptions {
   /// Frames that show the object mostly hidden (behind the hand) are tracked, not integrated
   /// (hidden_span.h).
   HiddenOptions hidden;
+  /// Frames whose registered pose the frame's depth sees through (the model where the frame
+  /// shows what is behind it): tried again from the object's points, else tracked, not
+  /// integrated (see_through.h).
+  SeeThroughOptions see_through;
   /// Refine with ICP against the model (the paper does; off is its "no ICP" baseline).
   bool use_icp = true;
   /// When ICP from the registration's pose pairs fewer than this share of the object's points,
@@ -266,6 +271,13 @@ struct FusionResult {
   /// Whether the frame showed the object mostly hidden (FusionOptions::hidden): registered and
   /// tracked, not integrated (nor taken to show what the surface leaves free).
   bool hidden = false;
+  /// The share of the model's pixels, raycast at the registered pose, that the frame sees
+  /// through (see_through.h; NaN where not checked); whether ICP tried again from the object's
+  /// points moved the pose (see_through_moved), and whether the frame was held out for it
+  /// (see_through_held: tracked, not integrated; `hidden` is then true too).
+  double see_through_share = std::numeric_limits<double>::quiet_NaN();
+  bool see_through_moved = false;
+  bool see_through_held = false;
   /// Whether the pose jumped farther from the previous one than FusionOptions::max_jump_mm or
   /// max_jump_deg allow and was taken, the jump having held (FusionOptions::jump_held_frames).
   bool jump_taken = false;
@@ -361,6 +373,17 @@ class ObjectFusion {
   // Whether the frame shows the object at fewer than FusionOptions::hidden's shown_share of the
   // pixels where the model, raycast at `pose` over the whole image, is in view.
   bool ShowsLittleOfModel(const ObjectPixels& object, const Rigid3& pose);
+  // The frame's depth against the model at `pose` (see_through.h); where it sees through, ICP
+  // once more from the model's visible part moved onto the object's points, kept where it
+  // pairs no fewer points and sees through less. Sets result's see_through fields.
+  void CheckSeeThrough(const ObjectPixels& object, const IcpSetup& setup, Rigid3* pose,
+                       FusionResult* result);
+  // ICP without the contacts from `pose` moved by the object points' centroid less `seen`'s
+  // visible centroid; taken (with `seen` updated) where it pairs no fewer points than the
+  // frame's ICP and sees through less.
+  void RetryOnObjectCentre(const ObjectPixels& object, const IcpSetup& setup, SeeThrough* seen,
+                           Rigid3* pose, FusionResult* result);
+  SeeThrough SeeThroughAt(const ObjectPixels& object, const Rigid3& pose, FusionResult* result);
   // Whether the registration's contacts spread far enough to fix a turn.
   bool ContactsSpread(const FusionResult& result) const;
   // The contacts that hold ICP, at where the registered `pose` moves them.
@@ -424,13 +447,19 @@ class ObjectFusion {
   FreeSpace free_space_;
   // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
   RaycastImage model_image_;
-  // The model seen at a frame's pose where it may show the object hidden (CoveredByNearer).
+  // The model seen at a frame's whole pose: whether it shows the object hidden, whether the
+  // frame sees through it.
   RaycastImage hidden_image_;
   // Where model_image_ was raycast from (cam_from_object).
   Rigid3 model_image_pose_;
   std::vector<std::uint16_t> near_depth_;
+  // The pixels the see-through check raycasts (SeeThroughPixels).
+  std::vector<std::uint16_t> see_through_depth_;
   bool started_ = false;
   Rigid3 cam_from_object_;
+  // Frames in a row that saw through the model at their pose (SeeThroughOptions::
+  // max_held_frames).
+  int see_through_frames_ = 0;
   // The share of its points the last frame's ICP paired (0: none yet).
   double last_paired_ = 0;
   // The object's motion between the last two fused frames (camera frame).

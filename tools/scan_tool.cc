@@ -175,6 +175,14 @@ void PrintSummary(std::int64_t frames, const ihs::app::ScanRecord& record,
     std::printf("  %d frames showed the object mostly hidden behind the hand: tracked, not fused\n",
                 hidden);
   }
+  if (const int moved = count(summary, "see_through_moved_frames"),
+      held = count(summary, "see_through_held_frames");
+      moved + held > 0) {
+    std::printf(
+        "  %d frames saw through the model at their registered pose and were moved onto the "
+        "object's points; %d still did: tracked, not fused\n",
+        moved, held);
+  }
   if (const int jumps = count(summary, "jumps_taken"); jumps > 0) {
     std::printf(
         "  %d times the object was found far from where it was, frames in a row: taken as "

@@ -619,5 +619,170 @@ TEST(ObjectFusionTest, AJumpThatHoldsIsTheObjectsAndIsTaken) {
   EXPECT_LT(taken_mm, 3.0);
 }
 
+// A box of `half_mm` half-extents at `cam_from_box`, in front of a wall `wall_mm` from the
+// camera; pixels left of image column `hand_to_u` (and right of the box's left edge) see a
+// hand 30 mm in front of the box instead. The mask: the box's pixels the hand does not cover.
+struct BoxScene {
+  Frame frame;
+  std::vector<std::uint8_t> mask;
+};
+BoxScene RenderBoxScene(const Rigid3& cam_from_box, const Eigen::Vector3d& half_mm, double wall_mm,
+                        int hand_to_u) {
+  BoxScene scene{Frame::Blank(kIntrinsics.width, kIntrinsics.height, true), {}};
+  scene.mask.assign(scene.frame.depth_mm.size(), 0);
+  const Rigid3 box_from_cam = cam_from_box.Inverse();
+  const Eigen::Vector3d origin = box_from_cam.translation();
+  for (int v = 0; v < kIntrinsics.height; ++v) {
+    for (int u = 0; u < kIntrinsics.width; ++u) {
+      const int pixel = v * kIntrinsics.width + u;
+      const Eigen::Vector3d ray = box_from_cam.RotateVector(kIntrinsics.BackProject(u, v, 1.0));
+      double enter = 0, leave = std::numeric_limits<double>::infinity();
+      for (int axis = 0; axis < 3; ++axis) {
+        const double a = (-half_mm[axis] - origin[axis]) / ray[axis];
+        const double b = (half_mm[axis] - origin[axis]) / ray[axis];
+        enter = std::max(enter, std::min(a, b));
+        leave = std::min(leave, std::max(a, b));
+      }
+      const bool box = enter <= leave;
+      const bool hand = box && u < hand_to_u;
+      const double depth = hand ? enter - 30 : box ? enter : wall_mm;
+      scene.frame.depth_mm[pixel] = static_cast<std::uint16_t>(std::lround(depth));
+      scene.mask[pixel] = box && !hand;
+      const std::uint8_t grey = box ? 150 : 60;
+      for (int c = 0; c < 3; ++c) scene.frame.rgb[3 * pixel + c] = grey;
+    }
+  }
+  return scene;
+}
+
+TEST(ObjectFusionTest, APoseSlidAlongAFaceIsMovedBackByWhatTheFrameSeesThrough) {
+  // A 90 x 60 x 40 mm box, one face to the camera, moves 3 mm a frame to the left in front of
+  // a wall; a hand covers its left 25 mm, and in frames 8-13 all of it. Features on the face
+  // register each frame to the one before; the first frame after the hidden ones has none (the
+  // frame before did not show them) and only ICP registers it. Found again 21 mm on from where
+  // it was last seen, ICP slides the model along the face, which fixes no slide, and keeps it
+  // there; the model then overhangs the box's right edge onto the wall. Tried again from where the
+  // model's uncovered part lies on the box's points, ICP keeps the truth. The outline's term
+  // (silhouette.h) is off: in this clean scene it walks ICP to the box's edges by itself (3.05
+  // mm either way); in a generated cube turn found again 20 mm off after ten unseen frames, the
+  // hand over its edges, it did not (docs/fusion.md, "A pose the frame sees through").
+  const Eigen::Vector3d half(45, 30, 20);
+  constexpr int kFrames = 22, kHideFrom = 8, kHideTo = 14;
+  auto truth = [](int i) { return Rigid3::Translation({30.0 - 3 * i, 5, 600}); };
+  std::vector<Eigen::Vector3d> spots;  // On the face, right of the hand (box frame).
+  for (int k = 0; k < 40; ++k) {
+    spots.emplace_back(-15 + 55.0 * (k % 8) / 7, -25 + 50.0 * (k / 8) / 4, -half.z());
+  }
+  auto run = [&](const FusionOptions& options, std::vector<FusionResult>* results) {
+    ObjectFusion fusion(kIntrinsics, options);
+    double worst_mm = 0;
+    Rigid3 box_from_volume;
+    for (int i = 0; i < kFrames; ++i) {
+      const bool hidden = i >= kHideFrom && i < kHideTo;
+      const int hand_to_u =
+          hidden ? kIntrinsics.width
+                 : static_cast<int>(
+                       kIntrinsics.Project(truth(i) * Eigen::Vector3d(-half.x() + 25, 0, -half.z()))
+                           .x());
+      const BoxScene scene = RenderBoxScene(truth(i), half, 900, hand_to_u);
+      FusionInput input{&scene.frame, &scene.mask, {}};
+      const bool seen_before = i > 0 && !(i - 1 >= kHideFrom && i - 1 < kHideTo);
+      for (size_t k = 0; seen_before && !hidden && k < spots.size(); ++k) {
+        input.correspondences.Pairs("sift", MatchKind::kVisual)
+            .push_back({truth(i - 1) * spots[k], truth(i) * spots[k], static_cast<int>(k)});
+      }
+      results->push_back(fusion.Fuse(input));
+      if (i == 0) box_from_volume = truth(0).Inverse() * results->back().cam_from_object;
+      if (hidden) continue;
+      worst_mm = std::max(worst_mm, WorstPointError(results->back().cam_from_object, truth(i),
+                                                    box_from_volume, {half, -half}));
+    }
+    return worst_mm;
+  };
+  FusionOptions checked;
+  checked.silhouette.weight = 0;
+  FusionOptions unchecked = checked;
+  unchecked.see_through.max_share = 0;
+  std::vector<FusionResult> unchecked_results, checked_results;
+  const double unchecked_mm = run(unchecked, &unchecked_results);
+  const double checked_mm = run(checked, &checked_results);
+  const FusionResult& found = checked_results[kHideTo];
+  std::printf(
+      "a box found again 21 mm on: worst pose error %.2f mm unchecked, %.2f mm checked (%.1f %% "
+      "of the model seen through, moved: %d)\n",
+      unchecked_mm, checked_mm, 100 * found.see_through_share, found.see_through_moved);
+  EXPECT_GT(unchecked_mm, 10.0);
+  EXPECT_LT(checked_mm, 3.0);
+  EXPECT_TRUE(found.see_through_moved);
+  for (int i = 1; i < kFrames; ++i) {
+    if (i >= kHideFrom && i < kHideTo) {
+      EXPECT_EQ(checked_results[i].status, FusionStatus::kSkipped) << i;
+      continue;
+    }
+    EXPECT_LE(checked_results[i].see_through_share, checked.see_through.max_share) << i;
+    EXPECT_FALSE(checked_results[i].see_through_held) << i;
+  }
+}
+
+TEST(ObjectFusionTest, AModelPartTheFramesNoLongerShowHoldsFramesOutOnlyForAWhile) {
+  // The box face of the test above, moving 1 mm a frame, registered by its features; in frames
+  // 0-5 a 60 x 18 mm finger beside it is in the object's mask (the segmentation's mistake) and
+  // is fused into the model. From frame 6 it is gone: at the right pose every frame sees the
+  // wall through it (12-14 % of the model's samples). The pose is not tried elsewhere (that
+  // pairs fewer points); the frames are held out for SeeThroughOptions::max_held_frames in a
+  // row, then integrated as registered, and the scan goes on.
+  const Eigen::Vector3d half(45, 30, 20), finger_half(30, 9, 9);
+  constexpr int kFrames = 30, kFingerTo = 6;
+  auto truth = [](int i) { return Rigid3::Translation({10.0 - i, 5, 600}); };
+  std::vector<Eigen::Vector3d> spots;  // On the face, right of the hand (box frame).
+  for (int k = 0; k < 40; ++k) {
+    spots.emplace_back(-15 + 55.0 * (k % 8) / 7, -25 + 50.0 * (k / 8) / 4, -half.z());
+  }
+  ObjectFusion fusion(kIntrinsics);
+  const int max_held = SeeThroughOptions().max_held_frames;
+  Rigid3 box_from_volume;
+  double worst_mm = 0;
+  std::vector<int> held, integrated;
+  for (int i = 0; i < kFrames; ++i) {
+    const int hand_to_u = static_cast<int>(
+        kIntrinsics.Project(truth(i) * Eigen::Vector3d(-half.x() + 25, 0, -half.z())).x());
+    BoxScene scene = RenderBoxScene(truth(i), half, 900, hand_to_u);
+    if (i < kFingerTo) {
+      const Rigid3 cam_from_finger =
+          truth(i) * Rigid3::Translation({half.x() + 25, 10, -half.z() + finger_half.z()});
+      const BoxScene finger = RenderBoxScene(cam_from_finger, finger_half, 900, 0);
+      for (size_t p = 0; p < scene.mask.size(); ++p) {
+        if (!finger.mask[p] || finger.frame.depth_mm[p] >= scene.frame.depth_mm[p]) continue;
+        scene.frame.depth_mm[p] = finger.frame.depth_mm[p];
+        scene.mask[p] = 1;
+      }
+    }
+    FusionInput input{&scene.frame, &scene.mask, {}};
+    for (size_t k = 0; i > 0 && k < spots.size(); ++k) {
+      input.correspondences.Pairs("sift", MatchKind::kVisual)
+          .push_back({truth(i - 1) * spots[k], truth(i) * spots[k], static_cast<int>(k)});
+    }
+    const FusionResult result = fusion.Fuse(input);
+    ASSERT_NE(result.status, FusionStatus::kSkipped) << i << ": " << result.reason;
+    if (i == 0) box_from_volume = truth(0).Inverse() * result.cam_from_object;
+    worst_mm = std::max(worst_mm, WorstPointError(result.cam_from_object, truth(i), box_from_volume,
+                                                  {half, -half}));
+    EXPECT_FALSE(result.see_through_moved) << i;
+    if (i >= kFingerTo) {
+      EXPECT_GT(result.see_through_share, 0.05) << i;
+    }
+    if (result.see_through_held) held.push_back(i);
+    if (result.integrated_voxels > 0) integrated.push_back(i);
+  }
+  std::printf(
+      "a finger fused into the model: %zu frames held out (%d-%d), worst pose error %.2f mm\n",
+      held.size(), held.empty() ? -1 : held.front(), held.empty() ? -1 : held.back(), worst_mm);
+  ASSERT_EQ(held.size(), static_cast<size_t>(max_held));
+  EXPECT_EQ(held.front(), kFingerTo);
+  EXPECT_EQ(held.back(), kFingerTo + max_held - 1);
+  EXPECT_EQ(integrated.size(), static_cast<size_t>(kFrames - max_held));
+  EXPECT_LT(worst_mm, 3.0);
+}
+
 }  // namespace
 }  // namespace ihs::fusion
