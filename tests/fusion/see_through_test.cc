@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <stdexcept>
 
 namespace ihs::fusion {
@@ -95,6 +97,28 @@ TEST(SeeThroughTest, ThePixelsToRaycastAreASampleWithDepth) {
     EXPECT_EQ(near[p], frame.depth_mm[p]);
   }
   EXPECT_EQ(cast, 160 * 120 - 1);
+}
+
+TEST(SeeThroughTest, TheModelIsLookedForWhereTheObservedBoxProjects) {
+  // A 100 mm cube 600 mm in front of the camera, centred on its axis.
+  const Eigen::AlignedBox3f cube(Eigen::Vector3f::Constant(-50), Eigen::Vector3f::Constant(50));
+  const Rigid3 ahead = Rigid3::Translation({0, 0, 600});
+  const auto [u0, v0, u1, v1] = ImageBoxOf(cube, ahead, kIntrinsics);
+  // Its widest at its near face, 550 mm away.
+  const Eigen::Vector2d near_corner = kIntrinsics.Project({-50, -50, 550});
+  const Eigen::Vector2d far_corner = kIntrinsics.Project({50, 50, 550});
+  EXPECT_EQ(u0, static_cast<int>(std::floor(near_corner.x())));
+  EXPECT_EQ(v0, static_cast<int>(std::floor(near_corner.y())));
+  EXPECT_EQ(u1, static_cast<int>(std::ceil(far_corner.x())) + 1);
+  EXPECT_EQ(v1, static_cast<int>(std::ceil(far_corner.y())) + 1);
+  // Reaching behind the camera: the whole image; wholly beside it: a sliver at its edge.
+  EXPECT_EQ(ImageBoxOf(cube, Rigid3::Translation({0, 0, 30}), kIntrinsics),
+            (std::array<int, 4>{0, 0, 0, 0}));
+  const auto beside = ImageBoxOf(cube, Rigid3::Translation({2000, 0, 600}), kIntrinsics);
+  EXPECT_EQ(beside[0], kIntrinsics.width - 1);
+  EXPECT_EQ(beside[2], kIntrinsics.width);
+  EXPECT_EQ(ImageBoxOf(Eigen::AlignedBox3f(), ahead, kIntrinsics),
+            (std::array<int, 4>{0, 0, 0, 0}));
 }
 
 TEST(SeeThroughTest, BadOptionsAreRefused) {
