@@ -86,6 +86,8 @@ class ScanRecord {
   std::int64_t colour_still_frames_ = 0;
   // Frames that showed the object mostly hidden: tracked, not integrated (fusion/hidden_span.h).
   std::int64_t hidden_frames_ = 0;
+  // Frames that saw through the model at their pose: held out, and moved onto the object's
+  // points (fusion/see_through.h).
   std::int64_t see_through_held_frames_ = 0;
   std::int64_t see_through_moved_frames_ = 0;
   // Implausible jumps taken because they held (FusionOptions::jump_held_frames).

@@ -447,8 +447,8 @@ class ObjectFusion {
   FreeSpace free_space_;
   // Per-frame scratch kept between frames (fresh megabytes every frame cost page faults).
   RaycastImage model_image_;
-  // The model seen at a frame's whole pose: whether it shows the object hidden, whether the
-  // frame sees through it.
+  // The model seen from a frame's pose over the whole image (ShowsLittleOfModel) or a sample
+  // of it (SeeThroughAt).
   RaycastImage hidden_image_;
   // Where model_image_ was raycast from (cam_from_object).
   Rigid3 model_image_pose_;
