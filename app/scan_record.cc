@@ -130,6 +130,7 @@ void ScanRecord::Add(const FramePacket& packet) {
       entry["colour_kept_still"] = true;
       ++colour_still_frames_;
     }
+    if (fused.hand_blended_deg != 0) entry["hand_blended_deg"] = fused.hand_blended_deg;
     if (fused.hand_carried_deg > 0) {
       entry["hand_carried_deg"] = fused.hand_carried_deg;
       ++hand_carried_frames_;

@@ -542,6 +542,9 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "frames over which ICP's free directions are counted");
   r.Add("fusion.turn_carry.min_free_share", &u.turn_carry.min_free_share,
         "least share of those frames with a free direction for the hand to carry the turn");
+  r.Add("fusion.turn_carry.hand_weight", &u.turn_carry.hand_weight,
+        "where the hand turns on, the weight of its turn against the registered one about the "
+        "recognised axis (0: the registration's alone)");
   r.Add("fusion.coverage.max_incidence_deg", &u.coverage.max_incidence_deg,
         "a surface counts as seen from a camera within this angle of its normal, degrees "
         "(coverage)");

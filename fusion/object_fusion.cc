@@ -460,6 +460,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   }
   if (result->icp.ok) {
     *pose = result->icp.cam_from_volume;
+    BlendHandTurn(object, setup, pose, result);
     AlignColours(object, icp_predicted, pose, result);
     WeighStillByColour(object, setup, icp_predicted, pose, result);
     CheckSeeThrough(object, setup, pose, result);
@@ -470,6 +471,21 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   if (!result->pairwise.ok) return false;
   CheckSeeThrough(object, setup, pose, result);
   return true;
+}
+
+void ObjectFusion::BlendHandTurn(const ObjectPixels& object, const IcpSetup& setup, Rigid3* pose,
+                                 FusionResult* result) {
+  if (result->hand_turn != HandTurn::kOn || !(options_.turn_carry.hand_weight > 0)) return;
+  double moved_rad = 0;
+  const Rigid3 blended =
+      turn_carry_.Blend(cam_from_object_, *pose, *pose * pivot_in_object_, &moved_rad);
+  // ICP again from there, without the contacts: the surface fixes the directions it fixes
+  // (an axis or pivot a little off is taken back), the turn it leaves free stays.
+  IcpResult again = AlignAt(object, setup, blended, {}, result);
+  if (!again.ok) return;
+  result->icp = std::move(again);
+  *pose = result->icp.cam_from_volume;
+  result->hand_blended_deg = moved_rad * 180.0 / M_PI;
 }
 
 SeeThrough ObjectFusion::SeeThroughAt(const ObjectPixels& object, const Rigid3& pose,

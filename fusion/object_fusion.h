@@ -242,6 +242,9 @@ struct FusionResult {
   /// the frame, degrees. Where it turned back, the contacts were not used.
   HandTurn hand_turn = HandTurn::kUnknown;
   double hand_carried_deg = 0;
+  /// How far the hand's turn moved the registered one about the recognised axis, where the
+  /// two were weighed (TurnCarryOptions::hand_weight), degrees.
+  double hand_blended_deg = 0;
   /// Where this frame recognised the one-way turn: the turn of the earlier frames nothing
   /// registered, caught up from the next frame on (TurnCarryOptions::catch_up_frames), degrees.
   double hand_caught_up_deg = 0;
@@ -383,6 +386,10 @@ class ObjectFusion {
   // frame's ICP and sees through less.
   void RetryOnObjectCentre(const ObjectPixels& object, const IcpSetup& setup, SeeThrough* seen,
                            Rigid3* pose, FusionResult* result);
+  // Where the hand turns on: the registered turn about the recognised axis moved toward the
+  // hand's (TurnCarryOptions::hand_weight), then ICP without the contacts from there.
+  void BlendHandTurn(const ObjectPixels& object, const IcpSetup& setup, Rigid3* pose,
+                     FusionResult* result);
   SeeThrough SeeThroughAt(const ObjectPixels& object, const Rigid3& pose, FusionResult* result);
   // Whether the registration's contacts spread far enough to fix a turn.
   bool ContactsSpread(const FusionResult& result) const;

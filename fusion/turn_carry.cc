@@ -26,6 +26,8 @@ void TurnCarryOptions::Check() const {
                 "fusion.turn_carry.surface_frames must be in [1, 1000]");
   IHS_CHECK_ARG(min_free_share >= 0 && min_free_share <= 1,
                 "fusion.turn_carry.min_free_share must be in [0, 1]");
+  IHS_CHECK_ARG(hand_weight >= 0 && hand_weight <= 1,
+                "fusion.turn_carry.hand_weight must be in [0, 1]");
   IHS_CHECK_ARG(catch_up_frames >= 0 && catch_up_frames <= 10000,
                 "fusion.turn_carry.catch_up_frames must be in [0, 10000]");
 }
@@ -160,6 +162,15 @@ Rigid3 TurnCarry::Turn(const Rigid3& cam_from_object, const Eigen::Vector3d& piv
   const Rigid3 turn = Rigid3::Translation(pivot) * Rigid3::FromAxisAngle(axis, radians) *
                       Rigid3::Translation(-pivot);
   return turn * cam_from_object;
+}
+
+Rigid3 TurnCarry::Blend(const Rigid3& previous, const Rigid3& registered,
+                        const Eigen::Vector3d& pivot, double* moved_rad) const {
+  // The registered step's turn about the axis, where the previous pose put the axis.
+  const Eigen::AngleAxisd step(registered.rotation() * previous.rotation().transpose());
+  const double registered_rad = (step.axis() * step.angle()).dot(previous.rotation() * axis_);
+  *moved_rad = options_.hand_weight * (carried_rad_ - registered_rad);
+  return Turn(registered, pivot, *moved_rad);
 }
 
 }  // namespace ihs::fusion
