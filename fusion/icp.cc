@@ -80,7 +80,8 @@ class Aligner {
  public:
   Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
           const CameraIntrinsics& intrinsics, const IcpOptions& options,
-          const std::vector<IcpAnchor>& anchors, const IcpContour* contour);
+          const std::vector<IcpAnchor>& anchors, const IcpContour* contour,
+          const Rigid3& correction);
 
   // Runs the Gauss–Newton iterations until they converge, fail or run out; then, if the last
   // one lost most of the pairs the first had, goes back to the iterate that paired the most.
@@ -177,14 +178,16 @@ class Aligner {
 
 Aligner::Aligner(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                  const CameraIntrinsics& intrinsics, const IcpOptions& options,
-                 const std::vector<IcpAnchor>& anchors, const IcpContour* contour)
+                 const std::vector<IcpAnchor>& anchors, const IcpContour* contour,
+                 const Rigid3& correction)
     : points_(points),
       model_(model),
       intrinsics_(intrinsics),
       options_(options),
       anchors_(anchors),
       contour_(contour),
-      max_sq_(options.max_distance_mm * options.max_distance_mm) {
+      max_sq_(options.max_distance_mm * options.max_distance_mm),
+      correction_(correction) {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3f& point : points) centroid += point.cast<double>();
   centroid /= std::max<size_t>(1, points.size());
@@ -490,7 +493,7 @@ void CheckEnoughPairs(int needed, size_t point_count, IcpResult* result) {
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
                        const IcpOptions& options, const std::vector<IcpAnchor>& anchors,
-                       const IcpContour* contour) {
+                       const IcpContour* contour, const Rigid3* start) {
   options.Check();
   IHS_CHECK_ARG(model.width == intrinsics.width && model.height == intrinsics.height,
                 "the raycast is " << model.width << "x" << model.height << ", the camera "
@@ -500,7 +503,9 @@ IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const Raycast
   IHS_CHECK_ARG(
       !contour || !contour->pairable || contour->pairable->size() == model.depth_mm.size(),
       "the contour's pairable mask does not cover the raycast");
-  Aligner aligner(points, model, intrinsics, options, anchors, contour);
+  // correction · current = predicted (as seen), so the start's is predicted · start⁻¹.
+  const Rigid3 correction = start ? predicted * start->Inverse() : Rigid3();
+  Aligner aligner(points, model, intrinsics, options, anchors, contour, correction);
   aligner.Run();
   IcpResult result;
   result.iterations = aligner.iterations();

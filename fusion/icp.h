@@ -126,10 +126,12 @@ struct IcpAnchor {
 
 /// Aligns `points` (the current frame's object points, camera frame, mm) to `model` (the TSDF
 /// raycast at `predicted`, the predicted cam_from_volume) seen by a camera with `intrinsics`,
-/// together with `anchors` and, where given, the frame's `contour`.
+/// together with `anchors` and, where given, the frame's `contour`. With `start`, the
+/// iterations start from that cam_from_volume instead of `predicted` (the model still cast at
+/// `predicted`): a pose a little off the one the model was cast at needs no new raycast.
 IcpResult AlignToModel(const std::vector<Eigen::Vector3f>& points, const RaycastImage& model,
                        const CameraIntrinsics& intrinsics, const Rigid3& predicted,
                        const IcpOptions& options = {}, const std::vector<IcpAnchor>& anchors = {},
-                       const IcpContour* contour = nullptr);
+                       const IcpContour* contour = nullptr, const Rigid3* start = nullptr);
 
 }  // namespace ihs::fusion

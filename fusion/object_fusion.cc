@@ -460,7 +460,7 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   }
   if (result->icp.ok) {
     *pose = result->icp.cam_from_volume;
-    BlendHandTurn(object, setup, pose, result);
+    BlendHandTurn(object, setup, &icp_predicted, pose, result);
     AlignColours(object, icp_predicted, pose, result);
     WeighStillByColour(object, setup, icp_predicted, pose, result);
     CheckSeeThrough(object, setup, pose, result);
@@ -473,17 +473,20 @@ bool ObjectFusion::Refine(const ObjectPixels& object, const std::vector<PointMat
   return true;
 }
 
-void ObjectFusion::BlendHandTurn(const ObjectPixels& object, const IcpSetup& setup, Rigid3* pose,
-                                 FusionResult* result) {
+void ObjectFusion::BlendHandTurn(const ObjectPixels& object, const IcpSetup& setup,
+                                 Rigid3* icp_predicted, Rigid3* pose, FusionResult* result) {
   if (result->hand_turn != HandTurn::kOn || !(options_.turn_carry.hand_weight > 0)) return;
   double moved_rad = 0;
   const Rigid3 blended =
       turn_carry_.Blend(cam_from_object_, *pose, *pose * pivot_in_object_, &moved_rad);
   // ICP again from there, without the contacts: the surface fixes the directions it fixes
-  // (an axis or pivot a little off is taken back), the turn it leaves free stays.
-  IcpResult again = AlignAt(object, setup, blended, {}, result);
+  // (an axis or pivot a little off is taken back), the turn it leaves free stays. The blend
+  // moves the pose by a degree or less: the model as cast for the first ICP still pairs it.
+  IcpResult again = AlignFrom(object, setup, blended, result);
   if (!again.ok) return;
   result->icp = std::move(again);
+  // Its free directions are in the camera frame the model was cast from.
+  *icp_predicted = model_image_pose_;
   *pose = result->icp.cam_from_volume;
   result->hand_blended_deg = moved_rad * 180.0 / M_PI;
 }
@@ -631,6 +634,16 @@ IcpResult ObjectFusion::AlignAt(const ObjectPixels& object, const IcpSetup& setu
   const auto icp_start = SteadyClock::now();
   IcpResult icp = AlignToModel(object.points, model_image_, intrinsics_, predicted, setup.options,
                                anchors, setup.contour.points.empty() ? nullptr : &setup.contour);
+  result->icp_ms += MillisecondsSince(icp_start);
+  return icp;
+}
+
+IcpResult ObjectFusion::AlignFrom(const ObjectPixels& object, const IcpSetup& setup,
+                                  const Rigid3& start, FusionResult* result) const {
+  const auto icp_start = SteadyClock::now();
+  IcpResult icp =
+      AlignToModel(object.points, model_image_, intrinsics_, model_image_pose_, setup.options, {},
+                   setup.contour.points.empty() ? nullptr : &setup.contour, &start);
   result->icp_ms += MillisecondsSince(icp_start);
   return icp;
 }

@@ -387,9 +387,10 @@ class ObjectFusion {
   void RetryOnObjectCentre(const ObjectPixels& object, const IcpSetup& setup, SeeThrough* seen,
                            Rigid3* pose, FusionResult* result);
   // Where the hand turns on: the registered turn about the recognised axis moved toward the
-  // hand's (TurnCarryOptions::hand_weight), then ICP without the contacts from there.
-  void BlendHandTurn(const ObjectPixels& object, const IcpSetup& setup, Rigid3* pose,
-                     FusionResult* result);
+  // hand's (TurnCarryOptions::hand_weight), then ICP without the contacts from there, against
+  // the model as last raycast; `icp_predicted` becomes the pose that raycast was cast at.
+  void BlendHandTurn(const ObjectPixels& object, const IcpSetup& setup, Rigid3* icp_predicted,
+                     Rigid3* pose, FusionResult* result);
   SeeThrough SeeThroughAt(const ObjectPixels& object, const Rigid3& pose, FusionResult* result);
   // Whether the registration's contacts spread far enough to fix a turn.
   bool ContactsSpread(const FusionResult& result) const;
@@ -401,6 +402,11 @@ class ObjectFusion {
   // Raycasts the model at `predicted` and aligns the object's points to it (timed in `result`).
   IcpResult AlignAt(const ObjectPixels& object, const IcpSetup& setup, const Rigid3& predicted,
                     const std::vector<IcpAnchor>& anchors, FusionResult* result);
+  // Aligns the object's points, without anchors, from `start` to the model as last raycast
+  // (model_image_, cast at model_image_pose_): a start a little off that pose needs no new
+  // raycast (timed in `result`).
+  IcpResult AlignFrom(const ObjectPixels& object, const IcpSetup& setup, const Rigid3& start,
+                      FusionResult* result) const;
   // Moves `pose` (ICP's from `icp_predicted`) along the free directions ICP found so that the
   // object's colours land on the model's (model_image_; FusionOptions::colour).
   void AlignColours(const ObjectPixels& object, const Rigid3& icp_predicted, Rigid3* pose,

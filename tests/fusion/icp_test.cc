@@ -215,31 +215,52 @@ Frame Noisy(Frame frame, std::mt19937& rng) {
   return frame;
 }
 
-TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
-  // A sphere's model fused from views all around; the new view's prediction is turned by 10°
-  // about the centre (the same surface) and shifted by 4 mm (which the surface fixes).
+// A ball (60 mm radius) fused from noisy views all around, and a new noisy view of it.
+struct Ball {
+  static constexpr double kRadius = 60;
   const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
-  const Eigen::Vector3d radii(60, 60, 60);
   TsdfVolume volume;
-  std::mt19937 rng(3);
-  for (int a = 0; a < 8; ++a) {
-    for (double tilt : {-0.9, 0.0, 0.9}) {
-      const Rigid3 view = Rigid3::Translation({0, 0, 600}) *
-                          Rigid3::FromAxisAngle({1, 0, 0}, tilt) *
-                          Rigid3::FromAxisAngle({0, 1, 0}, a * M_PI / 4);
-      volume.Integrate(Noisy(test::RenderEllipsoid(intrinsics, view, radii), rng), {}, intrinsics,
-                       view);
-    }
-  }
-  const Rigid3 truth = Rigid3::Translation({5, -3, 580});
-  const Frame frame = Noisy(test::RenderEllipsoid(intrinsics, truth, radii), rng);
+  Rigid3 truth = Rigid3::Translation({5, -3, 580});
+  Frame frame;
   std::vector<Eigen::Vector3f> points;
-  for (int v = 0; v < frame.height; ++v) {
-    for (int u = 0; u < frame.width; ++u) {
-      const std::uint16_t z = frame.DepthAt(u, v);
-      if (z != 0) points.push_back(intrinsics.BackProject(u, v, z).cast<float>());
+
+  Ball() {
+    const Eigen::Vector3d radii = Eigen::Vector3d::Constant(kRadius);
+    std::mt19937 rng(3);
+    for (int a = 0; a < 8; ++a) {
+      for (double tilt : {-0.9, 0.0, 0.9}) {
+        const Rigid3 view = Rigid3::Translation({0, 0, 600}) *
+                            Rigid3::FromAxisAngle({1, 0, 0}, tilt) *
+                            Rigid3::FromAxisAngle({0, 1, 0}, a * M_PI / 4);
+        volume.Integrate(Noisy(test::RenderEllipsoid(intrinsics, view, radii), rng), {}, intrinsics,
+                         view);
+      }
+    }
+    frame = Noisy(test::RenderEllipsoid(intrinsics, truth, radii), rng);
+    for (int v = 0; v < frame.height; ++v) {
+      for (int u = 0; u < frame.width; ++u) {
+        const std::uint16_t z = frame.DepthAt(u, v);
+        if (z != 0) points.push_back(intrinsics.BackProject(u, v, z).cast<float>());
+      }
     }
   }
+};
+
+// The angle between two poses' rotations, degrees.
+double TurnBetween(const Rigid3& a, const Rigid3& b) {
+  return Eigen::AngleAxisd(a.rotation() * b.rotation().transpose()).angle() * 180 / M_PI;
+}
+
+TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
+  // The new view's prediction is turned by 10° about the centre (the same surface) and shifted
+  // by 4 mm (which the surface fixes).
+  const Ball ball;
+  const CameraIntrinsics& intrinsics = ball.intrinsics;
+  const TsdfVolume& volume = ball.volume;
+  const Rigid3& truth = ball.truth;
+  const Frame& frame = ball.frame;
+  const std::vector<Eigen::Vector3f>& points = ball.points;
+  const Eigen::Vector3d radii = Eigen::Vector3d::Constant(Ball::kRadius);
   const Rigid3 turned =
       truth * Rigid3::FromAxisAngle(Eigen::Vector3d(0.2, 1, 0.4), 10 * M_PI / 180);
   const Rigid3 predicted = Rigid3::Translation({4, 0, 0}) * turned;
@@ -336,6 +357,35 @@ TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
   EXPECT_LT((alone.cam_from_volume.translation() - truth.translation()).norm(), 0.3);
   EXPECT_EQ(anchored.free.size(), 3u);
   EXPECT_LT(turn_from(anchored, truth), 1.0);
+}
+
+TEST(IcpSphereTest, AStartOffTheCastPoseKeepsItsOwnFreeTurn) {
+  // The model cast at a prediction turned 10° and shifted 4 mm; ICP started from another pose,
+  // turned 3° from that prediction about another axis and shifted 2 mm, against the same cast
+  // (ObjectFusion's second ICP after the hand's turn is blended in): the ball's turn stays
+  // the start's, its centre goes where the surface puts it.
+  const Ball ball;
+  const Rigid3 predicted = Rigid3::Translation({4, 0, 0}) * ball.truth *
+                           Rigid3::FromAxisAngle(Eigen::Vector3d(0.2, 1, 0.4), 10 * M_PI / 180);
+  const Rigid3 start = Rigid3::Translation({0, 2, 0}) * predicted *
+                       Rigid3::FromAxisAngle(Eigen::Vector3d(1, 0, 0.3), 3 * M_PI / 180);
+  const RaycastImage model = ball.volume.Raycast(ball.intrinsics, predicted);
+  const IcpResult from_start = AlignToModel(ball.points, model, ball.intrinsics, predicted,
+                                            IcpOptions(), {}, nullptr, &start);
+  const IcpResult from_cast = AlignToModel(ball.points, model, ball.intrinsics, predicted);
+  ASSERT_TRUE(from_start.ok) << from_start.reason;
+  ASSERT_TRUE(from_cast.ok) << from_cast.reason;
+  const double shift = (from_start.cam_from_volume.translation() - ball.truth.translation()).norm();
+  std::printf(
+      "from the start: centre %.3f mm off, turned %.3f° from the start (%.3f° from the "
+      "cast pose); from the cast pose: %.3f° from the start\n",
+      shift, TurnBetween(from_start.cam_from_volume, start),
+      TurnBetween(from_start.cam_from_volume, predicted),
+      TurnBetween(from_cast.cam_from_volume, start));
+  EXPECT_EQ(from_start.free_directions, 3) << "a ball's three turns";
+  EXPECT_LT(shift, 0.3);
+  EXPECT_LT(TurnBetween(from_start.cam_from_volume, start), 0.2);
+  EXPECT_GT(TurnBetween(from_cast.cam_from_volume, start), 2.5) << "the start made no difference";
 }
 
 }  // namespace
