@@ -93,6 +93,14 @@ struct TrajectoryError {
   /// and the scan's along the truth's step axes (a scan that follows none of the turn: 0).
   double truth_turned_deg = 0;
   double scan_turned_deg = 0;
+  /// Where the turn was lost or made up: the steps in which the truth stood still (turned
+  /// less than 0.05°: the object let go, the hand swinging back), how many, and the scan's
+  /// turn in them about the truth's turn axis (its steps' axes summed, object frame; negative:
+  /// turned back) and in all (its steps' angles summed; a scan that holds the object: 0),
+  /// degrees.
+  int still_steps = 0;
+  double scan_turned_still_deg = 0;
+  double scan_wandered_still_deg = 0;
   int frames = 0;
   /// Per compared frame: its time stamp (s) and its error (mm).
   std::vector<double> times_s, errors_mm;

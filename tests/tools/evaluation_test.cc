@@ -106,6 +106,36 @@ TEST_F(EvaluationTest, TheRotationErrorAndTheTurnFollowedAreMeasured) {
   EXPECT_NEAR(one.rotation_final_deg, 0.0, 1e-6);
 }
 
+TEST_F(EvaluationTest, TheTurnWhileTheTruthStandsStillIsMeasured) {
+  const auto truth = ReadTumTrajectory(Gt() / "trajectory.txt");
+  const TrajectoryError exact = CompareTrajectory(Gt(), truth);
+  ASSERT_GT(exact.still_steps, 0) << "the fixture's hand reaches for the ball first";
+  EXPECT_NEAR(exact.scan_turned_still_deg, 0.0, 1e-3);
+  EXPECT_NEAR(exact.scan_wandered_still_deg, 0.0, 1e-3);
+
+  // The truth's turn axis (its steps summed, object frame) and a step where it stands still.
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  size_t still = 0;
+  for (size_t k = 1; k < truth.size(); ++k) {
+    const Eigen::AngleAxisd step(truth[k - 1].transform.rotation().transpose() *
+                                 truth[k].transform.rotation());
+    axis += step.angle() * step.axis();
+    if (step.angle() < 1e-5 && still == 0) still = k;
+  }
+  ASSERT_GT(still, 0u);
+  axis.normalize();
+  // A scan that turns the object back by 3° about that axis in that still step and follows the
+  // truth otherwise: 3° back while still, 3° in all.
+  std::vector<StampedPose> back = truth;
+  for (size_t k = still; k < back.size(); ++k) {
+    back[k].transform = back[k].transform * Rigid3::FromAxisAngle(axis, -3 * M_PI / 180);
+  }
+  const TrajectoryError turned_back = CompareTrajectory(Gt(), back);
+  EXPECT_EQ(turned_back.still_steps, exact.still_steps);
+  EXPECT_NEAR(turned_back.scan_turned_still_deg, -3.0, 1e-3);
+  EXPECT_NEAR(turned_back.scan_wandered_still_deg, 3.0, 1e-3);
+}
+
 TEST_F(EvaluationTest, ContactUseIsCountedAgainstTheTruesGraspsAndDistances) {
   const auto truth = ReadTumTrajectory(Gt() / "trajectory.txt");
   // The truth's own count, read here from contacts.csv: grasps (two or more fingertips
