@@ -271,10 +271,7 @@ TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
         AlignToModel(points, volume.Raycast(intrinsics, predicted), intrinsics, predicted, options);
     ASSERT_TRUE(result.ok) << result.reason;
     const double shift = (result.cam_from_volume.translation() - truth.translation()).norm();
-    const double turn =
-        Eigen::AngleAxisd(result.cam_from_volume.rotation() * turned.rotation().transpose())
-            .angle() *
-        180 / M_PI;
+    const double turn = TurnBetween(result.cam_from_volume, turned);
     std::printf(
         "min_constraint_over_noise %g: centre %.3f mm off, turned %.3f° from the prediction\n",
         ratio, shift, turn);
@@ -342,21 +339,17 @@ TEST(IcpSphereTest, TurnsTheSurfaceLeavesFreeKeepThePrediction) {
       AlignToModel(points, model, intrinsics, predicted, IcpOptions(), {}, &contour);
   const IcpResult anchored =
       AlignToModel(points, model, intrinsics, predicted, IcpOptions(), anchors, &contour);
-  auto turn_from = [](const IcpResult& fit, const Rigid3& pose) {
-    return Eigen::AngleAxisd(fit.cam_from_volume.rotation() * pose.rotation().transpose()).angle() *
-           180 / M_PI;
-  };
   std::printf(
       "with the outline (%d of %zu points paired): alone turned %.3f° from the prediction, "
       "anchored %.3f° from the truth\n",
-      alone.contour_pairs, contour.points.size(), turn_from(alone, turned),
-      turn_from(anchored, truth));
+      alone.contour_pairs, contour.points.size(), TurnBetween(alone.cam_from_volume, turned),
+      TurnBetween(anchored.cam_from_volume, truth));
   EXPECT_GT(contour.points.size(), 200u);
   EXPECT_EQ(alone.free_directions, 3) << "a ball's three turns, whatever its outline";
-  EXPECT_LT(turn_from(alone, turned), 0.2);
+  EXPECT_LT(TurnBetween(alone.cam_from_volume, turned), 0.2);
   EXPECT_LT((alone.cam_from_volume.translation() - truth.translation()).norm(), 0.3);
   EXPECT_EQ(anchored.free.size(), 3u);
-  EXPECT_LT(turn_from(anchored, truth), 1.0);
+  EXPECT_LT(TurnBetween(anchored.cam_from_volume, truth), 1.0);
 }
 
 TEST(IcpSphereTest, AStartOffTheCastPoseKeepsItsOwnFreeTurn) {
