@@ -404,6 +404,9 @@ void AddFusionOptions(OptionRegistry& r, fusion::FusionOptions* options) {
         "colours also from the previous pose, kept where the colours match better");
   r.Add("fusion.colour_still_margin", &u.colour_still_margin,
         "... by more than this much correlation");
+  r.Add("fusion.colour_recheck_frames", &u.colour_recheck_frames,
+        "after a frame whose colours show no pattern, the colour alignment looks again this "
+        "many frames later (1: every frame)");
   r.Add("fusion.hidden.share", &u.hidden.share,
         "a frame with fewer than this share of the most object points of the recent frames in "
         "view shows the object hidden: tracked, not integrated (0: never)");

@@ -608,12 +608,18 @@ ColourAlignResult AlignColour(const Frame& frame, const std::vector<std::uint8_t
   if (options.remove_shading) {
     result.shading_share =
         RemoveShading(model, intrinsics, options.shading_blur_px, &frame_grey, &model_grey);
-    if (result.shading_share > options.max_shading_share) return skip("shading, no pattern");
+    if (result.shading_share > options.max_shading_share) {
+      result.no_pattern = true;
+      return skip("shading, no pattern");
+    }
   }
   // Both must show it: a pattern of the object's is in the model as well (hand pixels at the
   // mask's edge, a shadow, are in one frame).
   result.pattern_spread = std::min(Spread(frame_grey), Spread(model_grey));
-  if (result.pattern_spread < options.min_grey_spread) return skip("no pattern to align");
+  if (result.pattern_spread < options.min_grey_spread) {
+    result.no_pattern = true;
+    return skip("no pattern to align");
+  }
   // Every stride-th pixel, fewer on a large object (max_points).
   int held = 0;
   for (std::uint8_t valid : frame_grey.valid) held += valid;

@@ -93,6 +93,9 @@ struct ColourAlignResult {
   /// Whether it ran and moved the pose (else `reason`).
   bool applied = false;
   std::string reason;
+  /// Whether it stopped because the object's colours show no pattern: the shading explains
+  /// them (max_shading_share) or what is left spreads too little (min_grey_spread).
+  bool no_pattern = false;
   /// predicted_from_current (as IcpResult's correction): takes the current camera's points to
   /// where the model's raycast sees them.
   Rigid3 correction;

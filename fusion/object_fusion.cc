@@ -57,6 +57,7 @@ void FusionOptions::Check() const {
   IHS_CHECK_ARG(icp_retry_gain > 0, "fusion.icp_retry_gain must be positive");
   IHS_CHECK_ARG(std::isfinite(colour_still_margin),
                 "fusion.colour_still_margin must be a finite number");
+  IHS_CHECK_ARG(colour_recheck_frames >= 1, "fusion.colour_recheck_frames must be at least 1");
 }
 
 ObjectFusion::ObjectFusion(const CameraIntrinsics& intrinsics, FusionOptions options)
@@ -649,11 +650,17 @@ IcpResult ObjectFusion::AlignFrom(const ObjectPixels& object, const IcpSetup& se
 }
 
 void ObjectFusion::AlignColours(const ObjectPixels& object, const Rigid3& icp_predicted,
-                                Rigid3* pose, FusionResult* result) const {
+                                Rigid3* pose, FusionResult* result) {
   if (!options_.colour.enabled || result->icp.free.empty()) return;
+  if (colour_skips_left_ > 0) {
+    --colour_skips_left_;
+    result->colour.reason = "no pattern in a recent frame";
+    return;
+  }
   const auto start = SteadyClock::now();
   result->colour = AlignColoursOf(object, result->icp, icp_predicted, pose);
   result->colour_ms += MillisecondsSince(start);
+  if (result->colour.no_pattern) colour_skips_left_ = options_.colour_recheck_frames - 1;
 }
 
 ColourAlignResult ObjectFusion::AlignColoursOf(const ObjectPixels& object, const IcpResult& icp,

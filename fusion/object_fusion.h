@@ -92,6 +92,12 @@ struct FusionOptions {
   /// turn a ball that stands still; the colours, which see its pattern stand, tell.
   bool colour_weighs_still = true;
   double colour_still_margin = 0.0;
+  /// After a frame whose colours showed no pattern (ColourAlignOptions::max_shading_share,
+  /// min_grey_spread), the colour alignment looks again only this many frames later: the side
+  /// the camera sees changes over many frames, and on a uniform object every frame's look cost
+  /// 2.3-3.1 ms for nothing (docs/app.md). A label turning into view is aligned at most this
+  /// many frames late. 1: every frame.
+  int colour_recheck_frames = 8;
   /// Where the pairwise registration has nothing (no features, no contacts), whether the
   /// object is predicted to move on as between the last two fused frames (constant velocity)
   /// rather than to stand still — only when the last frame's ICP left no direction free (where
@@ -409,8 +415,9 @@ class ObjectFusion {
                       FusionResult* result) const;
   // Moves `pose` (ICP's from `icp_predicted`) along the free directions ICP found so that the
   // object's colours land on the model's (model_image_; FusionOptions::colour).
+  // Skipped for FusionOptions::colour_recheck_frames after a frame without a pattern.
   void AlignColours(const ObjectPixels& object, const Rigid3& icp_predicted, Rigid3* pose,
-                    FusionResult* result) const;
+                    FusionResult* result);
   ColourAlignResult AlignColoursOf(const ObjectPixels& object, const IcpResult& icp,
                                    const Rigid3& icp_predicted, Rigid3* pose) const;
   // ICP and the colours from the previous pose, kept where the colours match better
@@ -500,6 +507,8 @@ class ObjectFusion {
   Rigid3 hand_turn_since_;
   bool hand_turn_known_ = true;
   KeyframeGraph keyframes_;
+  // Frames the colour alignment still skips after one that showed no pattern.
+  int colour_skips_left_ = 0;
   // Frames fused so far (the stamp of keyframes and views).
   int fused_frames_ = 0;
 };

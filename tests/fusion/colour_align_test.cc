@@ -21,9 +21,12 @@ namespace {
 
 constexpr double kRadius = 40.0;
 
+// How much of the ball wears the print.
+enum class Print { kNone, kAll, kHalf /* where the object frame's z > 0 */ };
+
 // Paints the ball seen at `cam_from_object`: a printed pattern of the object frame's directions
-// (none with `patterned` false), shaded by a light at the camera, with a little noise.
-void Paint(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bool patterned,
+// (where `print` says), shaded by a light at the camera, with a little noise.
+void Paint(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, Print print,
            std::mt19937& rng, Frame* frame) {
   std::normal_distribution<double> noise(0.0, 2.0);
   const Eigen::Vector3d centre = cam_from_object.translation();
@@ -37,7 +40,7 @@ void Paint(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bo
       const double phi = std::atan2(d.x(), d.z()), theta = std::asin(std::clamp(d.y(), -1.0, 1.0));
       // A print: dark patches on a light ground, nowhere alike.
       double albedo = 0.7;
-      if (patterned) {
+      if (print == Print::kAll || (print == Print::kHalf && d.z() > 0)) {
         albedo =
             std::sin(5 * phi + 1.3) * std::cos(4 * theta) + 0.5 * std::sin(3 * phi + 7 * theta) > 0
                 ? 0.9
@@ -57,7 +60,7 @@ void Paint(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bo
   }
 }
 
-Frame Ball(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bool patterned,
+Frame Ball(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, Print print,
            std::mt19937& rng) {
   Frame frame = test::RenderEllipsoid(intrinsics, cam_from_object,
                                       Eigen::Vector3d(kRadius, kRadius, kRadius));
@@ -65,8 +68,13 @@ Frame Ball(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bo
   for (std::uint16_t& depth : frame.depth_mm) {
     if (depth != 0) depth = static_cast<std::uint16_t>(std::lround(depth + noise(rng)));
   }
-  Paint(intrinsics, cam_from_object, patterned, rng, &frame);
+  Paint(intrinsics, cam_from_object, print, rng, &frame);
   return frame;
+}
+
+Frame Ball(const CameraIntrinsics& intrinsics, const Rigid3& cam_from_object, bool patterned,
+           std::mt19937& rng) {
+  return Ball(intrinsics, cam_from_object, patterned ? Print::kAll : Print::kNone, rng);
 }
 
 double TurnDeg(const Rigid3& a, const Rigid3& b) {
@@ -271,6 +279,97 @@ TEST(ColourAlignTest, ABallTurnedByTheHandsContactsIsNotKeptStill) {
   const StillRun on = BallWithContacts(true, /*held=*/true, 0);
   EXPECT_LT(on.end_deg, 2.0);
   EXPECT_LT(on.kept_still, 3);
+}
+
+// A ball turned 3° a frame about its vertical axis by a hand whose three contacts hold it, for
+// `frames` frames: each frame's pose and whether the colours were looked at, ran to the end
+// and moved the pose. `recheck`: FusionOptions::colour_recheck_frames.
+struct ColourRun {
+  std::vector<Rigid3> poses;
+  std::vector<bool> looked, applied;
+};
+
+ColourRun TurnedByContacts(Print print, int recheck, int frames) {
+  const CameraIntrinsics intrinsics = CameraIntrinsics::Carmine109();
+  std::mt19937 rng(23);
+  FusionOptions options;
+  options.colour_recheck_frames = recheck;
+  ObjectFusion fusion(intrinsics, options);
+  const Eigen::Vector3d centre(8, -6, 510);
+  auto turned = [&](double degrees) {
+    // The print (object z > 0) faces away from the camera at 0°, toward it at 180°.
+    return Rigid3::Translation(centre) *
+           Rigid3::FromAxisAngle(Eigen::Vector3d::UnitY(), degrees * M_PI / 180);
+  };
+  const std::vector<Eigen::Vector3d> touched = {
+      {kRadius, 0, -10}, {-kRadius * 0.7, 5, -kRadius * 0.7}, {0, -kRadius * 0.8, -20}};
+  ColourRun run;
+  for (int i = 0; i < frames; ++i) {
+    const Frame frame = Ball(intrinsics, turned(3.0 * i), print, rng);
+    std::vector<std::uint8_t> mask(frame.depth_mm.size());
+    for (size_t p = 0; p < mask.size(); ++p) mask[p] = frame.depth_mm[p] != 0;
+    FusionInput input{&frame, &mask, {}};
+    if (i > 0) {
+      // The contacts are where the hand holds the ball (its camera side), turning with it.
+      for (const Eigen::Vector3d& q : touched) {
+        const Eigen::Vector3d at = turned(3.0 * i).rotation().transpose() * q;
+        input.correspondences.Pairs("contacts", MatchKind::kContact)
+            .push_back({turned(3.0 * (i - 1)) * at, turned(3.0 * i) * at});
+      }
+    }
+    const FusionResult result = fusion.Fuse(input);
+    EXPECT_NE(result.status, FusionStatus::kSkipped) << "frame " << i << ": " << result.reason;
+    run.poses.push_back(result.cam_from_object);
+    run.looked.push_back(
+        result.colour.applied ||
+        (!result.colour.reason.empty() && result.colour.reason != "no pattern in a recent frame"));
+    run.applied.push_back(result.colour.applied);
+  }
+  return run;
+}
+
+// On a uniform ball the colours show no pattern; looking again only every few frames changes
+// no pose and skips most of the looks.
+TEST(ColourAlignTest, AUniformBallsColoursAreLookedAtOnlyEveryFewFrames) {
+  const ColourRun every = TurnedByContacts(Print::kNone, 1, 40);
+  const ColourRun few = TurnedByContacts(Print::kNone, 8, 40);
+  int looked_every = 0, looked_few = 0;
+  for (size_t i = 0; i < every.poses.size(); ++i) {
+    looked_every += every.looked[i], looked_few += few.looked[i];
+    EXPECT_FALSE(every.applied[i]) << "frame " << i << ": a uniform ball was aligned";
+    EXPECT_LT((every.poses[i].translation() - few.poses[i].translation()).norm(), 1e-6);
+    EXPECT_LT(TurnDeg(every.poses[i], few.poses[i]), 1e-6) << "frame " << i;
+  }
+  std::printf("uniform ball: colours looked at in %d of 40 frames every frame, %d every 8th\n",
+              looked_every, looked_few);
+  EXPECT_EQ(looked_every, 40 - 1);  // The first frame starts the volume: nothing to align to.
+  EXPECT_LE(looked_few, 6);
+}
+
+// A ball printed on one half, its plain half toward the camera first, turned until the print
+// faces it: the colours align it again at most `recheck` frames later than looking every frame.
+TEST(ColourAlignTest, APrintTurningIntoViewIsAlignedWithinTheRecheckFrames) {
+  const int frames = 90;  // 267° of turn: the print comes round and is fused.
+  const ColourRun every = TurnedByContacts(Print::kHalf, 1, frames);
+  const ColourRun few = TurnedByContacts(Print::kHalf, 8, frames);
+  auto first_applied = [](const ColourRun& run) {
+    for (size_t i = 0; i < run.applied.size(); ++i) {
+      if (run.applied[i]) return static_cast<int>(i);
+    }
+    return -1;
+  };
+  const int a = first_applied(every), b = first_applied(few);
+  int applied_every = 0, applied_few = 0;
+  for (size_t i = 0; i < every.applied.size(); ++i)
+    applied_every += every.applied[i], applied_few += few.applied[i];
+  std::printf(
+      "half-printed ball: first aligned in frame %d looking every frame, %d every 8th; aligned "
+      "in %d and %d frames\n",
+      a, b, applied_every, applied_few);
+  ASSERT_GT(a, 10) << "the print was in view from the start: no test";
+  EXPECT_GE(b, a);
+  EXPECT_LT(b, a + 8);
+  EXPECT_GT(applied_few, applied_every - 8);
 }
 
 TEST(ColourAlignTest, WithoutFreeDirectionsOrColourNothingRuns) {
